@@ -1,0 +1,44 @@
+"""Angle ranges: runs of flagged samples on the cam-angle circle."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from camcad._typing import FloatArray
+
+__all__ = ["flagged_ranges", "format_ranges"]
+
+
+def flagged_ranges(phi: FloatArray, mask: np.ndarray) -> list[tuple[float, float]]:
+    """Contiguous runs of ``mask`` over the sorted cam angles ``phi`` [rad].
+
+    A run that crosses 360° is merged with the one starting at 0°, so its
+    start angle is larger than its end angle. Returns ``[(start, end), ...]``
+    in radians.
+    """
+    mask = np.asarray(mask, dtype=bool)
+    if not mask.any():
+        return []
+    if mask.all():
+        return [(float(phi[0]), float(phi[-1]))]
+    edges = np.flatnonzero(np.diff(mask.astype(np.int8)))
+    starts = list(edges[mask[edges + 1]] + 1)
+    ends = list(edges[mask[edges]])
+    if mask[0]:
+        starts.insert(0, 0)
+    if mask[-1]:
+        ends.append(len(mask) - 1)
+    runs = [(float(phi[a]), float(phi[b])) for a, b in zip(starts, ends)]
+    if mask[0] and mask[-1] and len(runs) > 1:
+        first, last = runs[0], runs.pop()
+        runs[0] = (last[0], first[1])
+    return runs
+
+
+def format_ranges(ranges: list[tuple[float, float]]) -> str:
+    """``'12.3°–45.6°, 300.0°–10.0°'`` from ranges in radians."""
+    return ", ".join(
+        f"{math.degrees(a):.1f}°–{math.degrees(b):.1f}°" for a, b in ranges
+    )

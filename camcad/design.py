@@ -1,0 +1,656 @@
+"""The design file: its schema, defaults and validation with field paths.
+
+A design is a TOML file with the tables ``[cam]``, ``[follower]``,
+``[[motion]]``, ``[dynamics]``, ``[fit]``, ``[dxf]``, ``[mesh]``, ``[tables]``
+and ``[gcode]``. :func:`load_design` turns it into a frozen :class:`Design`
+or raises :class:`~camcad.errors.DesignError` naming the field path
+(``motion[2].angle``), the value and what is allowed.
+
+Units at this edge: lengths mm, angles degrees, speed rpm, mass kg, force N,
+torque N·mm, stress and moduli MPa. Inside the specs angles are radians; the
+attribute docstrings say which.
+"""
+
+from __future__ import annotations
+
+import difflib
+import enum
+import math
+import sys
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from camcad.errors import DesignError
+from camcad.motion.laws import LAWS, Law, make_law
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+__all__ = [
+    "CamSpec",
+    "Design",
+    "Direction",
+    "Dialect",
+    "DxfSpec",
+    "DynamicsModel",
+    "DynamicsSpec",
+    "FitSpec",
+    "FollowerKind",
+    "FollowerSpec",
+    "GcodeSpec",
+    "MeshSpec",
+    "Rotation",
+    "SegmentKind",
+    "SegmentSpec",
+    "TablesSpec",
+    "load_design",
+    "parse_design",
+]
+
+DEG = math.pi / 180.0
+FULL_TURN_DEG = 360.0
+ANGLE_SUM_TOL_DEG = 1e-9
+LIFT_CLOSE_TOL_MM = 1e-9
+
+
+class Rotation(enum.Enum):
+    """Direction the cam turns, seen from the viewer."""
+
+    CCW = "ccw"
+    CW = "cw"
+
+
+class FollowerKind(enum.Enum):
+    """Kinds of follower."""
+
+    TRANSLATING_ROLLER = "translating-roller"
+    TRANSLATING_FLAT = "translating-flat"
+
+
+class SegmentKind(enum.Enum):
+    """Kinds of motion segment."""
+
+    RISE = "rise"
+    RETURN = "return"
+    DWELL = "dwell"
+
+
+class DynamicsModel(enum.Enum):
+    """Dynamic models: energy method (Quintero & Vanegas 2016) or guided tappet (Hren et al.)."""
+
+    ENERGY = "energy"
+    GUIDED_TAPPET = "guided-tappet"
+
+
+class Dialect(enum.Enum):
+    """G-code dialects."""
+
+    LINUXCNC = "linuxcnc"
+    GRBL = "grbl"
+    GENERIC = "generic"
+
+
+class Direction(enum.Enum):
+    """Milling direction."""
+
+    CLIMB = "climb"
+    CONVENTIONAL = "conventional"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CamSpec:
+    """The cam plate. Lengths mm; ``max_pressure_angle`` and ``sample_step`` rad."""
+
+    name: str = "cam"
+    base_radius: float
+    rotation: Rotation = Rotation.CCW
+    speed_rpm: float = 100.0
+    thickness: float = 10.0
+    bore: float = 0.0  # bore diameter [mm]; 0: no bore
+    keyway_width: float = 0.0
+    keyway_depth: float = 0.0
+    max_pressure_angle: float = 30.0 * DEG
+    min_curvature_radius: float | None = None  # mm; None: 0 for roller, 1 mm for flat
+    sample_step: float = 0.1 * DEG
+
+    @property
+    def omega(self) -> float:
+        """Cam angular speed ω [rad/s]."""
+        return self.speed_rpm * 2.0 * math.pi / 60.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FollowerSpec:
+    """The follower. Lengths mm."""
+
+    kind: FollowerKind = FollowerKind.TRANSLATING_ROLLER
+    roller_radius: float = 0.0
+    offset: float = 0.0  # e > 0 puts the follower axis at x = +e (ccw)
+    face_width: float | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SegmentSpec:
+    """One rise, return or dwell. ``span`` rad, ``lift`` mm (positive for rise and return)."""
+
+    kind: SegmentKind
+    span: float
+    lift: float = 0.0
+    law: Law | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DynamicsSpec:
+    """Masses, springs, friction and materials. SI-mm units: kg, N, N/mm, N·mm, MPa, mm."""
+
+    model: DynamicsModel = DynamicsModel.ENERGY
+    follower_mass: float = 0.0
+    spring_rate: float = 0.0  # N/mm
+    spring_preload: float = 0.0  # N at s = 0
+    friction_torque: float = 0.0  # N·mm
+    gravity: bool = True
+    min_contact_force: float = 0.0  # N
+    # guided tappet (Hren et al., section 2)
+    f1: float = 0.0
+    f2: float = 0.0
+    f3: float = 0.0
+    a_m: float = 0.0  # mm
+    b_m: float = 0.0  # mm
+    wire_diameter: float | None = None  # mm, coil spring by eq. 13
+    coil_diameter: float | None = None  # mm
+    active_coils: float | None = None
+    shear_modulus: float | None = None  # MPa
+    preload_deflection: float | None = None  # mm (y1)
+    # contact stress
+    contact_width: float | None = None  # mm; None: the cam thickness
+    cam_modulus: float = 206000.0  # MPa
+    cam_poisson: float = 0.3
+    follower_modulus: float = 206000.0  # MPa
+    follower_poisson: float = 0.3
+    allowable_stress: float | None = None  # MPa
+
+    @property
+    def uses_coil_spring(self) -> bool:
+        """Whether the spring is given by its coil geometry (Hren et al., eq. 13)."""
+        return self.wire_diameter is not None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FitSpec:
+    """NURBS fit settings. ``tolerance`` mm."""
+
+    tolerance: float = 1e-3
+    max_control_points: int = 500
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DxfSpec:
+    """DXF settings. ``chord_tolerance`` mm, for the polyline DXF."""
+
+    pitch_curve: bool = True
+    chord_tolerance: float = 0.005
+    annotate: bool = True
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MeshSpec:
+    """Solid settings. ``chord_tolerance`` mm."""
+
+    formats: tuple[str, ...] = ("stl",)
+    chord_tolerance: float = 0.005
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TablesSpec:
+    """Resolution of ``points.csv`` and ``lift.csv``; ``step`` rad."""
+
+    step: float = 1.0 * DEG
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GcodeSpec:
+    """Milling settings. Lengths mm, feeds mm/min, ``start_angle`` rad."""
+
+    tool_diameter: float = 6.0
+    tool_number: int = 1
+    tolerance: float = 0.005
+    dialect: Dialect = Dialect.LINUXCNC
+    direction: Direction = Direction.CLIMB
+    stock_to_leave: float = 0.2
+    step_down: float = 2.0
+    breakthrough: float = 0.5
+    lead_radius: float | None = None  # None: the tool diameter
+    start_angle: float = 0.0
+    tab_count: int = 0
+    tab_width: float = 6.0
+    tab_height: float = 1.0
+    clearance_height: float = 10.0
+    safe_height: float = 2.0
+    feed: float = 600.0
+    plunge_feed: float = 150.0
+    spindle_rpm: float = 10000.0
+    coolant: bool = False
+    mill_bore: bool = False
+
+    @property
+    def tool_radius(self) -> float:
+        """Tool radius [mm]."""
+        return self.tool_diameter / 2.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Design:
+    """A validated design: everything camcad needs, in mm and radians."""
+
+    cam: CamSpec
+    follower: FollowerSpec
+    motion: tuple[SegmentSpec, ...]
+    dynamics: DynamicsSpec = field(default_factory=DynamicsSpec)
+    fit: FitSpec = field(default_factory=FitSpec)
+    dxf: DxfSpec = field(default_factory=DxfSpec)
+    mesh: MeshSpec = field(default_factory=MeshSpec)
+    tables: TablesSpec = field(default_factory=TablesSpec)
+    gcode: GcodeSpec = field(default_factory=GcodeSpec)
+    source: str = ""
+
+    def with_base_radius(self, base_radius: float) -> Design:
+        """The same design with another base radius [mm]."""
+        return replace(self, cam=replace(self.cam, base_radius=base_radius))
+
+    @property
+    def min_curvature_radius(self) -> float:
+        """Required smallest convex profile radius [mm] (0 roller, 1 flat by default)."""
+        if self.cam.min_curvature_radius is not None:
+            return self.cam.min_curvature_radius
+        return 1.0 if self.follower.kind is FollowerKind.TRANSLATING_FLAT else 0.0
+
+
+# ---------------------------------------------------------------------------
+# schema: one rule per key; the rule converts and checks the TOML value
+
+
+Check = Callable[[Any], str | None]
+
+
+@dataclass(frozen=True, slots=True)
+class _Rule:
+    kind: str  # "float", "int", "bool", "str", "enum", "strlist"
+    default: Any = None
+    required: bool = False
+    check: Check | None = None
+    scale: float = 1.0  # multiply floats by this (degrees -> rad)
+    enum: type[enum.Enum] | None = None
+    attr: str | None = None  # dataclass attribute name when it differs from the key
+
+
+def _positive(v: float) -> str | None:
+    return None if v > 0 else "must be > 0"
+
+
+def _non_negative(v: float) -> str | None:
+    return None if v >= 0 else "must be ≥ 0"
+
+
+def _fraction(v: float) -> str | None:
+    return None if 0 <= v < 1 else "must be in [0, 1)"
+
+
+def _poisson(v: float) -> str | None:
+    return None if 0 <= v < 0.5 else "must be in [0, 0.5)"
+
+
+def _below(limit: float, unit: str) -> Check:
+    def check(v: float) -> str | None:
+        if not 0 < v < limit:
+            return f"must be in (0, {limit:g}) {unit}"
+        return None
+
+    return check
+
+
+_MESH_FORMATS = ("stl", "obj", "ply", "off", "3mf", "vtu")
+
+
+def _mesh_formats(v: list[str]) -> str | None:
+    bad = [f for f in v if f not in _MESH_FORMATS]
+    if bad:
+        return f"unknown format {bad[0]!r}; allowed: {', '.join(_MESH_FORMATS)}"
+    if not v:
+        return "must list at least one format"
+    return None
+
+
+_SECTIONS: dict[str, dict[str, _Rule]] = {
+    "cam": {
+        "name": _Rule("str", "cam"),
+        "base_radius": _Rule("float", required=True, check=_positive),
+        "rotation": _Rule("enum", Rotation.CCW, enum=Rotation),
+        "speed_rpm": _Rule("float", 100.0, check=_positive),
+        "thickness": _Rule("float", 10.0, check=_positive),
+        "bore": _Rule("float", 0.0, check=_non_negative),
+        "keyway_width": _Rule("float", 0.0, check=_non_negative),
+        "keyway_depth": _Rule("float", 0.0, check=_non_negative),
+        "max_pressure_angle": _Rule("float", 30.0, check=_below(90.0, "degrees"), scale=DEG),
+        "min_curvature_radius": _Rule("float", None, check=_non_negative),
+        "sample_step_deg": _Rule(
+            "float", 0.1, check=_below(10.0, "degrees"), scale=DEG, attr="sample_step"
+        ),
+    },
+    "follower": {
+        "type": _Rule("enum", FollowerKind.TRANSLATING_ROLLER, enum=FollowerKind, attr="kind"),
+        "roller_radius": _Rule("float", 0.0, check=_non_negative),
+        "offset": _Rule("float", 0.0),
+        "face_width": _Rule("float", None, check=_positive),
+    },
+    "dynamics": {
+        "model": _Rule("enum", DynamicsModel.ENERGY, enum=DynamicsModel),
+        "follower_mass": _Rule("float", 0.0, check=_non_negative),
+        "spring_rate": _Rule("float", 0.0, check=_non_negative),
+        "spring_preload": _Rule("float", 0.0, check=_non_negative),
+        "friction_torque": _Rule("float", 0.0, check=_non_negative),
+        "gravity": _Rule("bool", True),
+        "min_contact_force": _Rule("float", 0.0, check=_non_negative),
+        "f1": _Rule("float", 0.0, check=_fraction),
+        "f2": _Rule("float", 0.0, check=_fraction),
+        "f3": _Rule("float", 0.0, check=_fraction),
+        "a_m": _Rule("float", 0.0, check=_non_negative),
+        "b_m": _Rule("float", 0.0, check=_non_negative),
+        "wire_diameter": _Rule("float", None, check=_positive),
+        "coil_diameter": _Rule("float", None, check=_positive),
+        "active_coils": _Rule("float", None, check=_positive),
+        "shear_modulus": _Rule("float", None, check=_positive),
+        "preload_deflection": _Rule("float", None, check=_non_negative),
+        "contact_width": _Rule("float", None, check=_positive),
+        "cam_modulus": _Rule("float", 206000.0, check=_positive),
+        "cam_poisson": _Rule("float", 0.3, check=_poisson),
+        "follower_modulus": _Rule("float", 206000.0, check=_positive),
+        "follower_poisson": _Rule("float", 0.3, check=_poisson),
+        "allowable_stress": _Rule("float", None, check=_positive),
+    },
+    "fit": {
+        "tolerance": _Rule("float", 1e-3, check=_positive),
+        "max_control_points": _Rule("int", 500, check=lambda v: None if v >= 8 else "must be ≥ 8"),
+    },
+    "dxf": {
+        "pitch_curve": _Rule("bool", True),
+        "chord_tolerance": _Rule("float", 0.005, check=_positive),
+        "annotate": _Rule("bool", True),
+    },
+    "mesh": {
+        "formats": _Rule("strlist", ("stl",), check=_mesh_formats),
+        "chord_tolerance": _Rule("float", 0.005, check=_positive),
+    },
+    "tables": {
+        "step_deg": _Rule("float", 1.0, check=_below(90.0, "degrees"), scale=DEG, attr="step"),
+    },
+    "gcode": {
+        "tool_diameter": _Rule("float", 6.0, check=_positive),
+        "tool_number": _Rule("int", 1, check=lambda v: None if v >= 1 else "must be ≥ 1"),
+        "tolerance": _Rule("float", 0.005, check=_positive),
+        "dialect": _Rule("enum", Dialect.LINUXCNC, enum=Dialect),
+        "direction": _Rule("enum", Direction.CLIMB, enum=Direction),
+        "stock_to_leave": _Rule("float", 0.2, check=_non_negative),
+        "step_down": _Rule("float", 2.0, check=_positive),
+        "breakthrough": _Rule("float", 0.5, check=_non_negative),
+        "lead_radius": _Rule("float", None, check=_positive),
+        "start_angle": _Rule("float", 0.0, scale=DEG),
+        "tab_count": _Rule("int", 0, check=lambda v: None if v >= 0 else "must be ≥ 0"),
+        "tab_width": _Rule("float", 6.0, check=_positive),
+        "tab_height": _Rule("float", 1.0, check=_positive),
+        "clearance_height": _Rule("float", 10.0, check=_positive),
+        "safe_height": _Rule("float", 2.0, check=_positive),
+        "feed": _Rule("float", 600.0, check=_positive),
+        "plunge_feed": _Rule("float", 150.0, check=_positive),
+        "spindle_rpm": _Rule("float", 10000.0, check=_positive),
+        "coolant": _Rule("bool", False),
+        "mill_bore": _Rule("bool", False),
+    },
+}
+
+_SPEC_CLASSES: dict[str, type] = {
+    "cam": CamSpec,
+    "follower": FollowerSpec,
+    "dynamics": DynamicsSpec,
+    "fit": FitSpec,
+    "dxf": DxfSpec,
+    "mesh": MeshSpec,
+    "tables": TablesSpec,
+    "gcode": GcodeSpec,
+}
+
+_MOTION_KEYS = ("kind", "angle", "lift", "law")
+
+
+def _suggest(key: str, allowed: list[str]) -> str:
+    close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return f"unknown key {key!r}{hint} (allowed: {', '.join(allowed)})"
+
+
+def _convert(path: str, rule: _Rule, value: Any) -> Any:
+    """Convert one TOML value by its rule, or raise DesignError naming the path."""
+    kind = rule.kind
+    if kind == "float":
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise DesignError(path, f"expected a number, got {value!r}")
+        out: Any = float(value)
+        if not math.isfinite(out):
+            raise DesignError(path, f"expected a finite number, got {value!r}")
+    elif kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise DesignError(path, f"expected a whole number, got {value!r}")
+        out = value
+    elif kind == "bool":
+        if not isinstance(value, bool):
+            raise DesignError(path, f"expected true or false, got {value!r}")
+        out = value
+    elif kind == "str":
+        if not isinstance(value, str):
+            raise DesignError(path, f"expected a string, got {value!r}")
+        out = value
+    elif kind == "strlist":
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise DesignError(path, f"expected a list of strings, got {value!r}")
+        out = tuple(v.lower() for v in value)
+    elif kind == "enum":
+        assert rule.enum is not None
+        allowed = [m.value for m in rule.enum]
+        if not isinstance(value, str) or value not in allowed:
+            close = difflib.get_close_matches(str(value), allowed, n=1, cutoff=0.6)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise DesignError(path, f"{value!r} is not allowed{hint} (allowed: {', '.join(allowed)})")
+        out = rule.enum(value)
+    else:  # pragma: no cover - schema error
+        raise AssertionError(kind)
+    if rule.check is not None:
+        problem = rule.check(out)
+        if problem:
+            raise DesignError(path, f"{value!r} {problem}")
+    if kind == "float":
+        out *= rule.scale
+    return out
+
+
+def _section(name: str, table: Any) -> dict[str, Any]:
+    """Validate one table against its rules; return dataclass keyword arguments."""
+    if not isinstance(table, Mapping):
+        raise DesignError(name, f"expected a table [{name}], got {table!r}")
+    rules = _SECTIONS[name]
+    for key in table:
+        if key not in rules:
+            raise DesignError(f"{name}.{key}", _suggest(key, list(rules)))
+    kwargs: dict[str, Any] = {}
+    for key, rule in rules.items():
+        attr = rule.attr or key
+        if key in table:
+            kwargs[attr] = _convert(f"{name}.{key}", rule, table[key])
+        elif rule.required:
+            raise DesignError(f"{name}.{key}", "is required")
+    return kwargs
+
+
+def _segment(index: int, table: Any) -> SegmentSpec:
+    path = f"motion[{index}]"
+    if not isinstance(table, Mapping):
+        raise DesignError(path, f"expected a table, got {table!r}")
+    kind_value = table.get("kind")
+    if kind_value is None:
+        raise DesignError(f"{path}.kind", "is required (allowed: rise, return, dwell)")
+    kind = _convert(f"{path}.kind", _Rule("enum", enum=SegmentKind), kind_value)
+    if "angle" not in table:
+        raise DesignError(f"{path}.angle", "is required (degrees of cam rotation, > 0)")
+    span = _convert(f"{path}.angle", _Rule("float", check=_below(360.0 + 1e-9, "degrees")), table["angle"])
+    if kind is SegmentKind.DWELL:
+        for key in table:
+            if key not in ("kind", "angle"):
+                raise DesignError(f"{path}.{key}", _suggest(key, ["kind", "angle"]) + " for a dwell")
+        return SegmentSpec(kind=kind, span=span * DEG)
+    law_params = {k: v for k, v in table.items() if k not in _MOTION_KEYS}
+    if "lift" not in table:
+        raise DesignError(f"{path}.lift", f"is required for a {kind.value} (mm, > 0)")
+    lift = _convert(f"{path}.lift", _Rule("float", check=_positive), table["lift"])
+    law_name = table.get("law")
+    if law_name is None:
+        raise DesignError(f"{path}.law", f"is required for a {kind.value} (allowed: {', '.join(LAWS)})")
+    if not isinstance(law_name, str):
+        raise DesignError(f"{path}.law", f"expected a law name, got {law_name!r}")
+    if law_name in LAWS:
+        allowed_keys = list(_MOTION_KEYS) + [p.name for p in LAWS[law_name].parameters]
+        for key in law_params:
+            if key not in allowed_keys:
+                raise DesignError(f"{path}.{key}", _suggest(key, allowed_keys))
+    try:
+        law = make_law(law_name, **law_params)
+    except DesignError as err:
+        raise DesignError(f"{path}.{err.path}", err.message) from None
+    return SegmentSpec(kind=kind, span=span * DEG, lift=lift, law=law)
+
+
+def _check_program(segments: tuple[SegmentSpec, ...]) -> None:
+    if not segments:
+        raise DesignError("motion", "at least one [[motion]] segment is required")
+    total = sum(seg.span for seg in segments) / DEG
+    if abs(total - FULL_TURN_DEG) > ANGLE_SUM_TOL_DEG * FULL_TURN_DEG:
+        spans = " + ".join(f"{seg.span / DEG:g}" for seg in segments)
+        raise DesignError(
+            "motion", f"segment angles must total 360°, got {spans} = {total:g}°"
+        )
+    s = 0.0
+    for i, seg in enumerate(segments):
+        if seg.kind is SegmentKind.RISE:
+            s += seg.lift
+        elif seg.kind is SegmentKind.RETURN:
+            s -= seg.lift
+            if s < -LIFT_CLOSE_TOL_MM:
+                raise DesignError(
+                    f"motion[{i}].lift",
+                    f"return of {seg.lift:g} mm takes the follower {-s:g} mm below the base circle",
+                )
+    if abs(s) > LIFT_CLOSE_TOL_MM:
+        rises = sum(g.lift for g in segments if g.kind is SegmentKind.RISE)
+        raise DesignError(
+            "motion",
+            f"the lift does not close: total rise {rises:g} mm but total return {rises - s:g} mm",
+        )
+
+
+def _check_design(design: Design) -> None:
+    cam, fol = design.cam, design.follower
+    if fol.kind is FollowerKind.TRANSLATING_ROLLER:
+        if fol.roller_radius <= 0:
+            raise DesignError(
+                "follower.roller_radius",
+                f"{fol.roller_radius:g} must be > 0 for a translating-roller follower",
+            )
+        if abs(fol.offset) >= cam.base_radius + fol.roller_radius:
+            raise DesignError(
+                "follower.offset",
+                f"|{fol.offset:g}| must be smaller than base_radius + roller_radius = "
+                f"{cam.base_radius + fol.roller_radius:g} mm",
+            )
+    bore_reach = max(cam.bore / 2.0, cam.bore / 2.0 + cam.keyway_depth if cam.keyway_width else 0)
+    if bore_reach >= cam.base_radius:
+        raise DesignError(
+            "cam.bore",
+            f"bore {cam.bore:g} mm (with keyway reaching {bore_reach:g} mm) must stay inside the "
+            f"base circle of radius {cam.base_radius:g} mm",
+        )
+    if (cam.keyway_width > 0) != (cam.keyway_depth > 0):
+        raise DesignError("cam.keyway_width", "keyway_width and keyway_depth must both be > 0 or both 0")
+    if cam.keyway_width > 0 and cam.bore <= 0:
+        raise DesignError("cam.keyway_width", "a keyway needs a bore (cam.bore > 0)")
+    if cam.keyway_width >= cam.bore > 0:
+        raise DesignError(
+            "cam.keyway_width", f"{cam.keyway_width:g} mm must be narrower than the bore {cam.bore:g} mm"
+        )
+    dyn = design.dynamics
+    coil = (dyn.wire_diameter, dyn.coil_diameter, dyn.active_coils, dyn.shear_modulus)
+    if any(v is not None for v in coil) and any(v is None for v in coil):
+        raise DesignError(
+            "dynamics.wire_diameter",
+            "a coil spring needs all of wire_diameter, coil_diameter, active_coils, shear_modulus",
+        )
+    if dyn.model is DynamicsModel.GUIDED_TAPPET:
+        if fol.kind is not FollowerKind.TRANSLATING_FLAT:
+            raise DesignError("dynamics.model", "'guided-tappet' needs a translating-flat follower")
+        if dyn.b_m <= dyn.a_m:
+            raise DesignError("dynamics.b_m", f"{dyn.b_m:g} mm must be greater than a_m = {dyn.a_m:g} mm")
+    gc = design.gcode
+    if gc.safe_height >= gc.clearance_height:
+        raise DesignError(
+            "gcode.safe_height",
+            f"{gc.safe_height:g} mm must be below clearance_height {gc.clearance_height:g} mm",
+        )
+
+
+def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
+    """Validate a design given as a TOML-like mapping.
+
+    Raises
+    ------
+    DesignError
+        Naming the field path, the value and what is allowed.
+    """
+    allowed = ["cam", "follower", "motion", *[s for s in _SECTIONS if s not in ("cam", "follower")]]
+    for key in data:
+        if key not in allowed:
+            raise DesignError(key, _suggest(key, allowed))
+    if "cam" not in data:
+        raise DesignError("cam", "the [cam] table is required")
+    specs: dict[str, Any] = {}
+    for name, cls in _SPEC_CLASSES.items():
+        specs[name] = cls(**_section(name, data.get(name, {})))
+    raw_motion = data.get("motion")
+    if not isinstance(raw_motion, list):
+        raise DesignError("motion", "expected one or more [[motion]] tables")
+    motion = tuple(_segment(i, seg) for i, seg in enumerate(raw_motion))
+    _check_program(motion)
+    design = Design(motion=motion, source=source, **specs)
+    _check_design(design)
+    return design
+
+
+def load_design(path: str | Path) -> Design:
+    """Read and validate a TOML design file.
+
+    Raises
+    ------
+    DesignError
+        When the file is missing, is not TOML, or is invalid.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise DesignError("", f"design file not found: {path}") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise DesignError("", f"cannot read design file {path}: {err}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise DesignError("", f"{path} is not valid TOML: {err}") from None
+    return parse_design(data, source=str(path))

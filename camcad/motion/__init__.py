@@ -1,0 +1,1 @@
+"""Follower motion: displacement laws and the motion program built from them."""

@@ -1,0 +1,270 @@
+"""Motion programs: ordered rise / dwell / return segments over one cam turn.
+
+A program maps the cam angle φ [rad] to the follower displacement s [mm] and
+its φ-derivatives v = ds/dφ [mm/rad], a = d²s/dφ² [mm/rad²] and
+j = d³s/dφ³ [mm/rad³], exactly, from each segment's law in closed form.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from camcad._typing import ArrayLike, FloatArray, readonly
+from camcad.design import SegmentKind, SegmentSpec
+
+__all__ = [
+    "TWO_PI",
+    "Breakpoint",
+    "Joint",
+    "Motion",
+    "MotionProgram",
+    "TimeMotion",
+]
+
+TWO_PI = 2.0 * math.pi
+# A jump smaller than this (relative to the derivative's scale) is continuity.
+_JUMP_RTOL = 1e-9
+_INTERIOR_EPS = 1e-12  # x-distance of the one-sided limits at a law's own breakpoints
+_INTERIOR_SLACK = 1e-6
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Motion:
+    """Follower motion sampled at cam angles.
+
+    Attributes
+    ----------
+    phi
+        (n,) cam angle φ [rad].
+    s
+        (n,) displacement [mm].
+    v
+        (n,) ds/dφ [mm/rad] (pseudo velocity).
+    a
+        (n,) d²s/dφ² [mm/rad²].
+    j
+        (n,) d³s/dφ³ [mm/rad³].
+    """
+
+    phi: FloatArray
+    s: FloatArray
+    v: FloatArray
+    a: FloatArray
+    j: FloatArray
+
+    def in_time(self, omega: float) -> TimeMotion:
+        """Time derivatives at constant cam speed ``omega`` [rad/s]."""
+        out = TimeMotion(
+            phi=self.phi,
+            velocity=self.v * omega,
+            acceleration=self.a * omega**2,
+            jerk=self.j * omega**3,
+        )
+        readonly(out.velocity, out.acceleration, out.jerk)
+        return out
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TimeMotion:
+    """Follower velocity [mm/s], acceleration [mm/s²] and jerk [mm/s³] at constant ω."""
+
+    phi: FloatArray
+    velocity: FloatArray
+    acceleration: FloatArray
+    jerk: FloatArray
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Breakpoint:
+    """A segment joint where the motion may lose smoothness.
+
+    ``continuity`` k means s is C^k there: 0 when v jumps (a corner of the
+    pitch curve), 1 when a jumps, 2 when j jumps, 3 when smooth to j.
+    """
+
+    phi: float  # rad
+    continuity: int
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Joint:
+    """Jumps (right minus left) of v [mm/rad], a [mm/rad²], j [mm/rad³] at a joint."""
+
+    phi: float  # rad
+    index: int  # the segment that starts here
+    dv: float
+    da: float
+    dj: float
+    continuity: int
+    internal: bool = False  # inside a segment, where its law switches formula
+
+    def describe(self) -> str:
+        """One line a user reads, e.g. ``acceleration jumps by 0.85 mm/rad² at 150°``."""
+        deg = math.degrees(self.phi)
+        where = " (inside the segment)" if self.internal else ""
+        parts = []
+        for name, unit, value in (
+            ("velocity", "mm/rad", self.dv),
+            ("acceleration", "mm/rad²", self.da),
+            ("jerk", "mm/rad³", self.dj),
+        ):
+            if value != 0.0:
+                parts.append(f"{name} jumps by {value:+.4g} {unit}")
+        if not parts:
+            return f"{deg:g}°{where}: smooth (s, v, a, j continuous)"
+        return f"{deg:g}°{where}: " + ", ".join(parts)
+
+
+@dataclass(frozen=True, slots=True)
+class MotionProgram:
+    """An ordered list of segments covering 360° of cam rotation.
+
+    Build it with :meth:`from_segments`; the design layer has already checked
+    that the spans total 2π and that the lift closes.
+    """
+
+    segments: tuple[SegmentSpec, ...]
+    starts: tuple[float, ...]  # rad, start angle of each segment
+    base_s: tuple[float, ...]  # mm, displacement at each segment's start
+
+    @classmethod
+    def from_segments(cls, segments: Sequence[SegmentSpec]) -> MotionProgram:
+        """Lay the segments end to end from φ = 0."""
+        starts, base_s = [], []
+        phi = s = 0.0
+        for seg in segments:
+            starts.append(phi)
+            base_s.append(s)
+            phi += seg.span
+            if seg.kind is SegmentKind.RISE:
+                s += seg.lift
+            elif seg.kind is SegmentKind.RETURN:
+                s -= seg.lift
+        return cls(tuple(segments), tuple(starts), tuple(base_s))
+
+    @property
+    def lift(self) -> float:
+        """Largest displacement of the program [mm]."""
+        ends = [b + (g.lift if g.kind is SegmentKind.RISE else 0.0) for b, g in zip(self.base_s, self.segments)]
+        return max([*self.base_s, *ends])
+
+    @property
+    def segment_bounds(self) -> tuple[float, ...]:
+        """Start angle of every segment [rad]; the first is 0."""
+        return self.starts
+
+    def _segment_of(self, phi: FloatArray) -> np.ndarray:
+        edges = np.asarray(self.starts[1:])
+        return np.searchsorted(edges, phi, side="right")
+
+    def _evaluate_segment(
+        self, index: int, x: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """s, v, a, j of segment ``index`` at normalised x ∈ [0, 1]."""
+        seg = self.segments[index]
+        base = self.base_s[index]
+        if seg.kind is SegmentKind.DWELL or seg.law is None:
+            zero = np.zeros_like(x)
+            return zero + base, zero, zero, zero
+        y, y1, y2, y3 = seg.law.evaluate(x)
+        h = seg.lift if seg.kind is SegmentKind.RISE else -seg.lift
+        beta = seg.span
+        # chain rule: x = (φ − φ0)/β, so d^k/dφ^k = β^-k d^k/dx^k
+        return base + h * y, h * y1 / beta, h * y2 / beta**2, h * y3 / beta**3
+
+    def evaluate(self, phi: ArrayLike) -> Motion:
+        """Displacement and its φ-derivatives at any cam angles.
+
+        Parameters
+        ----------
+        phi
+            Cam angles [rad], any shape; wrapped into [0, 2π).
+
+        Returns
+        -------
+        Motion
+            Flattened (n,) arrays. At a joint the segment that starts there is
+            used (right-continuous).
+        """
+        phi_in = np.asarray(phi, dtype=float).ravel()
+        wrapped = np.mod(phi_in, TWO_PI)
+        index = self._segment_of(wrapped)
+        s = np.zeros_like(wrapped)
+        v, a, j = np.zeros_like(s), np.zeros_like(s), np.zeros_like(s)
+        for k, seg in enumerate(self.segments):
+            mask = index == k
+            if not mask.any():
+                continue
+            x = np.clip((wrapped[mask] - self.starts[k]) / seg.span, 0.0, 1.0)
+            s[mask], v[mask], a[mask], j[mask] = self._evaluate_segment(k, x)
+        out = Motion(phi=phi_in.copy(), s=s, v=v, a=a, j=j)
+        readonly(out.phi, out.s, out.v, out.a, out.j)
+        return out
+
+    def joints(self) -> tuple[Joint, ...]:
+        """Jumps of v, a and j at every segment joint (360° → 0° included).
+
+        Points inside a segment where its law switches formula (the SCCA laws'
+        phase changes, the middle of a VAP rise, where y″ jumps) are reported
+        too, with ``internal=True``, since the fit needs knots there as well.
+        """
+        n = len(self.segments)
+        places: list[tuple[float, int, int, float, float, bool]] = []
+        for k, seg in enumerate(self.segments):
+            places.append((self.starts[k], (k - 1) % n, k, 1.0, 0.0, False))
+            for x in seg.law.breakpoints if seg.law is not None else ():
+                eps = _INTERIOR_EPS
+                places.append((self.starts[k] + x * seg.span, k, k, x - eps, x + eps, True))
+        out = []
+        for phi, left_k, right_k, x_left, x_right, internal in places:
+            left = self._evaluate_segment(left_k, np.array([x_left]))
+            right = self._evaluate_segment(right_k, np.array([x_right]))
+            cleaned = []
+            for order, (l_, r) in enumerate(zip(left[1:], right[1:]), start=1):
+                value = float(r[0] - l_[0])
+                ref = max(self._derivative_scale(left_k, order), self._derivative_scale(right_k, order))
+                # one-sided limits inside a law are taken ε away: allow for that slope
+                tol = (_JUMP_RTOL + (_INTERIOR_SLACK if internal else 0.0)) * ref
+                cleaned.append(0.0 if abs(value) <= tol else value)
+            continuity = next((order for order, value in enumerate(cleaned) if value != 0.0), 3)
+            out.append(
+                Joint(
+                    phi=phi,
+                    index=right_k,
+                    dv=cleaned[0],
+                    da=cleaned[1],
+                    dj=cleaned[2],
+                    continuity=continuity,
+                    internal=internal,
+                )
+            )
+        return tuple(out)
+
+    def _derivative_scale(self, index: int, order: int) -> float:
+        seg = self.segments[index]
+        return max(self.lift, 1.0) / seg.span**order
+
+    @property
+    def breakpoints(self) -> tuple[Breakpoint, ...]:
+        """Every segment joint with its continuity order (the fit puts knots here)."""
+        return tuple(Breakpoint(phi=jt.phi, continuity=jt.continuity) for jt in self.joints())
+
+    def sample_phi(self, step: float) -> FloatArray:
+        """Cam angles in [0, 2π): a uniform grid of ``step`` [rad] plus every breakpoint."""
+        n = max(int(math.ceil(TWO_PI / step - 1e-9)), 8)
+        grid = np.linspace(0.0, TWO_PI, n, endpoint=False)
+        marks = np.mod([bp.phi for bp in self.breakpoints], TWO_PI)
+        phi = np.union1d(grid, marks)
+        # drop grid points closer than 1e-9 rad to a breakpoint (keep the breakpoint)
+        keep = np.ones(phi.size, dtype=bool)
+        for b in marks:
+            near = np.abs(phi - b) < 1e-9 * TWO_PI
+            near[np.argmin(np.abs(phi - b))] = False
+            keep &= ~near
+        out = phi[keep]
+        readonly(out)
+        return out

@@ -1,0 +1,50 @@
+"""Shared fixtures: designs built in code and the shipped samples."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camcad.design import Design, parse_design
+
+ROOT = Path(__file__).resolve().parent.parent
+SAMPLES = sorted((ROOT / "samples").glob("*.toml"))
+
+
+def make_design(
+    *,
+    law: str = "cycloidal",
+    base_radius: float = 40.0,
+    roller_radius: float = 10.0,
+    offset: float = 0.0,
+    follower: str = "translating-roller",
+    rotation: str = "ccw",
+    lift: float = 20.0,
+    spans: tuple[float, float, float, float] = (150.0, 30.0, 150.0, 30.0),
+    params: dict[str, Any] | None = None,
+    extra: dict[str, Any] | None = None,
+) -> Design:
+    """A rise–dwell–return–dwell design with one law."""
+    p = params or {}
+    data: dict[str, Any] = {
+        "cam": {"name": f"test {law}", "base_radius": base_radius, "rotation": rotation, "thickness": 8.0},
+        "follower": {"type": follower, "offset": offset}
+        | ({"roller_radius": roller_radius} if follower == "translating-roller" else {}),
+        "motion": [
+            {"kind": "rise", "angle": spans[0], "lift": lift, "law": law, **p},
+            {"kind": "dwell", "angle": spans[1]},
+            {"kind": "return", "angle": spans[2], "lift": lift, "law": law, **p},
+            {"kind": "dwell", "angle": spans[3]},
+        ],
+    }
+    for key, value in (extra or {}).items():
+        data.setdefault(key, {}).update(value)
+    return parse_design(data)
+
+
+@pytest.fixture(params=SAMPLES, ids=[p.stem for p in SAMPLES])
+def sample_path(request: pytest.FixtureRequest) -> Path:
+    """Each shipped sample design file."""
+    return request.param

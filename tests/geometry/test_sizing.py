@@ -1,0 +1,51 @@
+"""Minimum base radius against closed forms."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from camcad.geometry import Cam, min_base_radius
+from tests.conftest import make_design
+
+
+@pytest.mark.parametrize("law", ["cycloidal", "harmonic", "poly-4567"])
+@pytest.mark.parametrize("limit_deg", [20.0, 30.0])
+def test_radial_roller_pressure_limit_matches_closed_form(law, limit_deg):
+    """Radial roller: tan α = v/(r_b + r_f + s) ≤ tan α_max ⇔ r_b ≥ max(v/tan α_max − s) − r_f."""
+    cam = Cam.from_design(make_design(law=law, base_radius=80.0, roller_radius=10.0, lift=30.0))
+    alpha = math.radians(limit_deg)
+    phi = cam.sample_phi()
+    m = cam.motion(phi)
+    expected = float(np.max(np.abs(m.v) / math.tan(alpha) - m.s)) - 10.0
+    result = min_base_radius(cam, max_pressure_angle=alpha)
+    assert result.limit == "pressure angle"
+    assert result.base_radius == pytest.approx(expected, abs=1e-5)
+    assert math.degrees(result.pressure_angle_max) == pytest.approx(limit_deg, abs=1e-4)
+
+
+def test_flat_follower_curvature_limit_matches_closed_form():
+    """Flat face: ρ = r_b + s + a ≥ ρ_min ⇔ r_b ≥ ρ_min − min(s + a)."""
+    cam = Cam.from_design(make_design(law="cycloidal", follower="translating-flat", lift=15.0))
+    m = cam.motion(cam.sample_phi())
+    expected = 5.0 - float(np.min(m.s + m.a))
+    result = min_base_radius(cam, min_curvature_radius=5.0)
+    assert result.limit == "curvature"
+    assert result.base_radius == pytest.approx(expected, abs=1e-5)
+
+
+def test_sized_radius_passes_and_a_smaller_one_fails():
+    cam = Cam.from_design(make_design(law="harmonic", offset=10.0, roller_radius=15.0, lift=40.0))
+    result = min_base_radius(cam, max_pressure_angle=math.radians(25), min_curvature_radius=2.0)
+    from dataclasses import replace
+
+    from camcad.geometry.sizing import feasible_margins
+
+    phi = cam.sample_phi()
+    for radius, ok in ((result.base_radius, True), (result.base_radius - 0.01, False)):
+        m_alpha, m_rho, _, _ = feasible_margins(
+            replace(cam, base_radius=radius), phi, max_pressure_angle=math.radians(25), min_curvature_radius=2.0
+        )
+        assert (m_alpha >= 0 and m_rho >= 0) is ok
