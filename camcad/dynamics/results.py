@@ -1,0 +1,171 @@
+"""The outcome of a dynamic analysis: per-sample arrays and the summary numbers.
+
+No file I/O here: :meth:`DynamicsResult.summary` gives the ``dynamics``
+section of ``summary.json`` and :meth:`DynamicsResult.csv_rows` the rows of
+``dynamics.csv``, both for the pipeline to write.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from camcad._typing import FloatArray
+from camcad.design import DynamicsModel
+from camcad.dynamics.jump import covering_arc
+from camcad.errors import JumpError
+
+__all__ = ["CSV_HEADER", "DynamicsResult"]
+
+CSV_HEADER = ("angle_deg", "contact_force_N", "torque_Nmm", "hertz_stress_MPa")
+"""Column names of ``dynamics.csv``."""
+
+
+def _deg(phi: float) -> float:
+    """Angle in [0, 360) degrees, rounded to 1e-6° so that summaries diff cleanly."""
+    return round(math.degrees(phi) % 360.0, 6)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DynamicsResult:
+    """Forces, torque and contact stress of the follower over the cam turn.
+
+    Attributes
+    ----------
+    model
+        The dynamic model used.
+    phi
+        (n,) cam angle φ [rad].
+    contact_force
+        (n,) contact force [N]: F_C along the common normal (energy method),
+        or the normal force N1 on the flat face (guided tappet). Negative
+        where the follower would leave the cam.
+    torque
+        (n,) drive torque on the cam shaft [N·mm], positive when the shaft
+        drives the cam in its sense of rotation.
+    hertz_stress
+        (n,) peak Hertz contact stress σ_max [MPa]; 0 where contact is lost.
+    normal_force
+        (n,) N1 [N] for the guided tappet (equals ``contact_force``); ``None``
+        for the energy method.
+    guide_force_near, guide_force_far
+        (n,) guide normal forces N2, N3 [N] of the guided tappet, else ``None``.
+    margin
+        ``[dynamics].min_contact_force`` [N]: contact counts as lost below it.
+    jump_ranges
+        (first, last) sample angle [rad] of every run where contact is lost;
+        first > last for a run through 0°.
+    min_preload
+        Smallest spring preload [N] that keeps the contact force ≥ margin.
+    preload_deflection
+        The same as a preload deflection y1 [mm] when the spring is given by
+        its coil, else ``None``.
+    speed_range_rpm
+        (low, high) cam speeds [rpm] that keep the contact force ≥ margin
+        (high may be ``inf``); ``None`` if no speed does.
+    allowable_stress
+        ``[dynamics].allowable_stress`` [MPa] or ``None``.
+    warnings
+        Findings for the report, one sentence each.
+    """
+
+    model: DynamicsModel
+    phi: FloatArray
+    contact_force: FloatArray
+    torque: FloatArray
+    hertz_stress: FloatArray
+    normal_force: FloatArray | None = None
+    guide_force_near: FloatArray | None = None
+    guide_force_far: FloatArray | None = None
+    margin: float = 0.0
+    jump_ranges: tuple[tuple[float, float], ...] = ()
+    min_preload: float = 0.0
+    preload_deflection: float | None = None
+    speed_range_rpm: tuple[float, float] | None = None
+    allowable_stress: float | None = None
+    warnings: tuple[str, ...] = ()
+
+    csv_header: ClassVar[tuple[str, ...]] = CSV_HEADER
+
+    @property
+    def jump(self) -> bool:
+        """Whether the contact force falls below the margin anywhere."""
+        return bool(self.jump_ranges)
+
+    @property
+    def jump_range(self) -> tuple[float, float] | None:
+        """Shortest arc (start, end) [rad] holding every loss of contact, or ``None``."""
+        return covering_arc(self.jump_ranges)
+
+    def summary(self) -> dict[str, Any]:
+        """Return the ``dynamics`` section of ``summary.json``.
+
+        Returns
+        -------
+        dict[str, Any]
+            ``torque_max_Nmm``, ``torque_max_angle_deg``, ``torque_min_Nmm``,
+            ``torque_min_angle_deg``, ``contact_force_max_N``,
+            ``contact_force_min_N``, ``jump`` (bool), ``jump_range_deg``
+            ([start, end] in degrees, start > end through 0°, or ``None``),
+            ``hertz_stress_max_MPa``, ``hertz_stress_max_angle_deg`` and
+            ``warnings`` (list of str). Plain Python values, JSON-ready.
+        """
+        k_max = int(np.argmax(self.torque))
+        k_min = int(np.argmin(self.torque))
+        k_stress = int(np.argmax(self.hertz_stress))
+        arc = self.jump_range
+        return {
+            "torque_max_Nmm": float(self.torque[k_max]),
+            "torque_max_angle_deg": _deg(float(self.phi[k_max])),
+            "torque_min_Nmm": float(self.torque[k_min]),
+            "torque_min_angle_deg": _deg(float(self.phi[k_min])),
+            "contact_force_max_N": float(np.max(self.contact_force)),
+            "contact_force_min_N": float(np.min(self.contact_force)),
+            "jump": self.jump,
+            "jump_range_deg": None if arc is None else [_deg(arc[0]), _deg(arc[1])],
+            "hertz_stress_max_MPa": float(self.hertz_stress[k_stress]),
+            "hertz_stress_max_angle_deg": _deg(float(self.phi[k_stress])),
+            "warnings": list(self.warnings),
+        }
+
+    def table(self) -> FloatArray:
+        """(n, 4) array of the ``dynamics.csv`` columns (see ``csv_header``).
+
+        Returns
+        -------
+        FloatArray
+            Columns: angle [deg], contact force [N], torque [N·mm], Hertz stress [MPa].
+        """
+        out = np.column_stack((np.degrees(self.phi), self.contact_force, self.torque, self.hertz_stress))
+        out.flags.writeable = False
+        return out
+
+    def csv_rows(self) -> list[tuple[str, ...]]:
+        """Rows of ``dynamics.csv``, the header first, numbers in a fixed format.
+
+        Returns
+        -------
+        list[tuple[str, ...]]
+            ``("angle_deg", ...)`` then one row per sample, every number with
+            6 decimals, ready for :func:`csv.writer`.
+        """
+        rows: list[tuple[str, ...]] = [CSV_HEADER]
+        for angle, force, torque, stress in self.table():
+            rows.append((f"{angle:.6f}", f"{force:.6f}", f"{torque:.6f}", f"{stress:.6f}"))
+        return rows
+
+    def raise_if_jump(self) -> None:
+        """Raise :class:`~camcad.errors.JumpError` if the follower leaves the cam.
+
+        Raises
+        ------
+        JumpError
+            With the first jump warning as its message.
+        """
+        if not self.jump:
+            return
+        message = next((w for w in self.warnings if "jump" in w or "below" in w), None)
+        raise JumpError(message or "the follower leaves the cam")
