@@ -1,0 +1,1 @@
+"""Exporters: DXF drawings, solid meshes, CSV tables and G-code."""

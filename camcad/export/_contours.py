@@ -1,0 +1,418 @@
+"""Shared 2-D contour code for the exporters: bore outline, curve flattening, areas.
+
+Conventions: points are (n, 2) arrays in the cam frame [mm]; a closed polygon
+does not repeat its first point; positive signed area means counter-clockwise.
+The keyway sits on the +y side of the bore, where the follower stands at cam
+angle φ = 0, so the drawing, the solid and the G-code share one angular
+reference.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from scipy.interpolate import BSpline
+
+from camcad._typing import FloatArray, readonly
+from camcad.fit.curve import BSplineCurve
+
+__all__ = [
+    "BoreOutline",
+    "analytic_area",
+    "bspline_area",
+    "bspline_length",
+    "circle_segments",
+    "flatten_bspline",
+    "flatten_curve",
+    "oriented",
+    "polygon_area",
+    "polygon_perimeter",
+]
+
+
+def polygon_area(points: FloatArray) -> float:
+    """Signed area of a closed polygon [mm²]; positive when counter-clockwise.
+
+    Parameters
+    ----------
+    points
+        (n, 2) vertices [mm], the first not repeated at the end.
+
+    Examples
+    --------
+    >>> polygon_area(np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]]))
+    2.0
+    """
+    x, y = points[:, 0], points[:, 1]
+    # Shoelace formula, centred to keep round-off at the scale of the polygon.
+    x = x - x.mean()
+    y = y - y.mean()
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def polygon_perimeter(points: FloatArray) -> float:
+    """Length of a closed polygon [mm]; (n, 2) vertices, first not repeated."""
+    return float(np.sum(np.linalg.norm(np.roll(points, -1, axis=0) - points, axis=1)))
+
+
+def oriented(points: FloatArray, *, ccw: bool) -> FloatArray:
+    """Return the polygon, its vertex order reversed if needed to run ccw (or cw)."""
+    if (polygon_area(points) > 0.0) != ccw:
+        points = points[::-1].copy()
+    return points
+
+
+def circle_segments(radius: float, chord_tolerance: float, sweep: float = 2.0 * math.pi) -> int:
+    """Chords needed for an arc of ``radius`` [mm] and ``sweep`` [rad] within ``chord_tolerance`` [mm].
+
+    Notes
+    -----
+    A chord spanning the angle Δ deviates from its arc by the sagitta
+    r(1 − cos(Δ/2)); Δ is chosen so that this is at most the tolerance.
+
+    Examples
+    --------
+    >>> circle_segments(10.0, 0.01)
+    71
+    """
+    ratio = min(chord_tolerance / radius, 1.0)
+    max_step = 2.0 * math.acos(1.0 - ratio)
+    return max(3, math.ceil(sweep / max_step - 1e-9))
+
+
+def _span_starts(curve: BSplineCurve) -> tuple[FloatArray, FloatArray]:
+    """Start and end parameter of every non-empty knot span inside the domain."""
+    a, b = curve.domain
+    breaks = np.unique(curve.knots[(curve.knots >= a) & (curve.knots <= b)])
+    return breaks[:-1], breaks[1:]
+
+
+def _spline(curve: BSplineCurve) -> BSpline:
+    return BSpline(curve.knots, curve.control_points, curve.degree, extrapolate=False)
+
+
+def flatten_bspline(curve: BSplineCurve, chord_tolerance: float) -> FloatArray:
+    """Polyline through a non-periodic B-spline within ``chord_tolerance`` [mm].
+
+    Parameters
+    ----------
+    curve
+        Clamped B-spline of degree ≤ 3 (``periodic=False``).
+    chord_tolerance
+        Largest distance between the curve and its polyline [mm].
+
+    Returns
+    -------
+    FloatArray
+        (n, 2) vertices [mm], read-only. For a closed curve (last control point
+        equal to the first) the end point is not repeated.
+
+    Notes
+    -----
+    On a knot span of a curve of degree ≤ 3, C'' is linear (or constant), so
+    ‖C''‖ is largest at a span end. A chord over a parameter step h deviates
+    from the curve by at most h²/8 · max‖C''‖ (error of linear
+    interpolation, de Boor 2001, ch. II, eq. 2.2), so choosing
+    h ≤ √(8 tol / max‖C''‖) per span is a bound, not an estimate.
+
+    References
+    ----------
+    .. [1] de Boor (2001), A Practical Guide to Splines, revised ed.,
+       Springer. doi:10.1007/978-1-4612-6333-3
+    """
+    if curve.periodic:
+        raise ValueError("flatten_bspline needs the clamped form of the curve")
+    if curve.degree > 3:
+        raise ValueError(f"flatten_bspline supports degree ≤ 3, got {curve.degree}")
+    if chord_tolerance <= 0.0:
+        raise ValueError(f"chord_tolerance must be > 0, got {chord_tolerance!r}")
+    spline = _spline(curve)
+    second = spline.derivative(2) if curve.degree >= 2 else None
+    start, end = _span_starts(curve)
+    h = end - start
+    if second is None:
+        counts = np.ones(start.size, dtype=int)
+    else:
+        # C'' is linear on the span: extrapolate its end values from two interior points.
+        q1 = np.asarray(second(start + 0.25 * h))
+        q3 = np.asarray(second(start + 0.75 * h))
+        at_start = 1.5 * q1 - 0.5 * q3
+        at_end = 1.5 * q3 - 0.5 * q1
+        bound = np.maximum(np.linalg.norm(at_start, axis=1), np.linalg.norm(at_end, axis=1))
+        counts = np.maximum(1, np.ceil(h * np.sqrt(bound / (8.0 * chord_tolerance)))).astype(int)
+    params = np.concatenate(
+        [s + (e - s) * np.arange(k) / k for s, e, k in zip(start, end, counts, strict=True)]
+    )
+    closed = np.array_equal(curve.control_points[0], curve.control_points[-1])
+    if not closed:
+        params = np.append(params, end[-1])
+        points = np.asarray(spline(params[:-1]))
+        points = np.vstack((points, curve.control_points[-1]))
+    else:
+        points = np.asarray(spline(params))
+    points = np.ascontiguousarray(points, dtype=float)
+    readonly(points)
+    return points
+
+
+def _gauss_legendre(start: FloatArray, end: FloatArray, nodes: int) -> tuple[FloatArray, FloatArray]:
+    """Gauss-Legendre nodes and weights on each interval [start_i, end_i], flattened."""
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    half = 0.5 * (end - start)
+    mid = 0.5 * (end + start)
+    u = (mid[:, None] + half[:, None] * x[None, :]).ravel()
+    weight = (half[:, None] * w[None, :]).ravel()
+    return u, weight
+
+
+def bspline_area(curve: BSplineCurve) -> float:
+    """Signed area enclosed by a closed B-spline [mm²]; positive when counter-clockwise.
+
+    Notes
+    -----
+    A = ½∮(x dy − y dx) (Green's theorem). On each knot span of a degree-p
+    curve the integrand x y' − y x' is a polynomial of degree 2p − 1, which
+    p-point Gauss-Legendre integrates exactly, so the result is exact up to
+    round-off.
+    """
+    spline = _spline(curve)
+    start, end = _span_starts(curve)
+    u, weight = _gauss_legendre(start, end, max(curve.degree, 1) + 1)
+    p = np.asarray(spline(u))
+    d = np.asarray(spline.derivative(1)(u))
+    return 0.5 * float(np.sum(weight * (p[:, 0] * d[:, 1] - p[:, 1] * d[:, 0])))
+
+
+def bspline_length(curve: BSplineCurve, *, nodes: int = 12) -> float:
+    """Arc length of a B-spline [mm], by ``nodes``-point Gauss-Legendre on each knot span."""
+    spline = _spline(curve)
+    start, end = _span_starts(curve)
+    u, weight = _gauss_legendre(start, end, nodes)
+    d = np.asarray(spline.derivative(1)(u))
+    return float(np.sum(weight * np.linalg.norm(d, axis=1)))
+
+
+class _Sample(Protocol):
+    """What :func:`analytic_area` and :func:`flatten_curve` need of a CurveSample."""
+
+    point: FloatArray
+    d1: FloatArray
+    d2: FloatArray
+
+
+def analytic_area(
+    sample: Callable[[FloatArray], _Sample],
+    breakpoints: Sequence[float] = (),
+    *,
+    nodes: int = 24,
+    pieces: int = 8,
+) -> tuple[float, float]:
+    """Signed area and length of a closed analytic curve P(φ), φ ∈ [0, 2π).
+
+    Parameters
+    ----------
+    sample
+        Maps (n,) angles [rad] to an object with ``point`` and ``d1 = dP/dφ``
+        (n, 2) [mm, mm/rad], e.g. ``cam.profile``.
+    breakpoints
+        Angles [rad] where derivatives of P may jump (motion segment joins).
+        The integral is split there, since Gauss-Legendre converges
+        exponentially only on pieces where the integrand is smooth.
+    nodes, pieces
+        Gauss-Legendre nodes per piece and pieces per interval between
+        breakpoints.
+
+    Returns
+    -------
+    tuple[float, float]
+        Signed area [mm²] (positive counter-clockwise) and arc length [mm].
+
+    Notes
+    -----
+    A = ½∫₀^{2π} (x y' − y x') dφ (Green's theorem), L = ∫ ‖P'‖ dφ.
+    """
+    two_pi = 2.0 * math.pi
+    cuts = np.unique(np.mod(np.asarray(breakpoints, dtype=float), two_pi))
+    cuts = np.unique(np.concatenate(([0.0], cuts, [two_pi])))
+    cuts = cuts[np.concatenate(([True], np.diff(cuts) > 1e-12))]
+    edges = np.concatenate(
+        [np.linspace(a, b, pieces + 1)[:-1] for a, b in itertools.pairwise(cuts)] + [[two_pi]]
+    )
+    phi, weight = _gauss_legendre(edges[:-1], edges[1:], nodes)
+    s = sample(phi)
+    p, d = s.point, s.d1
+    area = 0.5 * float(np.sum(weight * (p[:, 0] * d[:, 1] - p[:, 1] * d[:, 0])))
+    length = float(np.sum(weight * np.linalg.norm(d, axis=1)))
+    return area, length
+
+
+def flatten_curve(
+    sample: Callable[[FloatArray], _Sample],
+    chord_tolerance: float,
+    *,
+    breakpoints: Sequence[float] = (),
+    probe_step: float = math.radians(0.1),
+) -> FloatArray:
+    """Polyline through a closed analytic curve P(φ), φ ∈ [0, 2π), to a chord tolerance.
+
+    Parameters
+    ----------
+    sample
+        Maps (n,) angles [rad] to an object with ``point`` and ``d2 = d²P/dφ²``.
+    chord_tolerance
+        Target largest chord deviation [mm].
+    breakpoints
+        Angles [rad] always included as vertices.
+    probe_step
+        Grid [rad] on which the largest ‖P''‖ is looked for.
+
+    Returns
+    -------
+    FloatArray
+        (n, 2) vertices [mm], the first not repeated; read-only.
+
+    Notes
+    -----
+    A uniform step Δφ = √(8 tol / (1.25 max‖P''‖)) keeps the chord error
+    h²/8 · ‖P''‖ within the tolerance where the probe found the maximum; the
+    factor 1.25 covers peaks between probe points. Used for reference curves
+    (the pitch curve); the cam profile itself is flattened from the fitted
+    spline by the rigorous :func:`flatten_bspline`.
+    """
+    probe = np.arange(0.0, 2.0 * math.pi, probe_step)
+    peak = float(np.max(np.linalg.norm(sample(probe).d2, axis=1)))
+    step = math.sqrt(8.0 * chord_tolerance / max(1.25 * peak, 1e-300))
+    count = max(8, math.ceil(2.0 * math.pi / step))
+    phi = np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
+    extra = np.mod(np.asarray(breakpoints, dtype=float), 2.0 * math.pi)
+    phi = np.unique(np.concatenate((phi, extra)))
+    points = np.ascontiguousarray(sample(phi).point, dtype=float)
+    readonly(points)
+    return points
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BoreOutline:
+    """The bore, with an optional keyway on its +y side, as exact geometry.
+
+    Attributes
+    ----------
+    radius
+        Bore radius r [mm] (half the design's bore diameter).
+    keyway_width
+        Keyway width w [mm]; 0 for a plain bore.
+    keyway_depth
+        Keyway depth d [mm], from the bore surface; the keyway's flat end is
+        at y = r + d.
+    """
+
+    radius: float
+    keyway_width: float = 0.0
+    keyway_depth: float = 0.0
+
+    @classmethod
+    def from_cam_spec(cls, bore: float, keyway_width: float, keyway_depth: float) -> BoreOutline | None:
+        """Build the outline for a bore *diameter* [mm] and keyway size; None without a bore."""
+        if bore <= 0.0:
+            return None
+        if keyway_width > 0.0 and keyway_depth > 0.0:
+            return cls(radius=bore / 2.0, keyway_width=keyway_width, keyway_depth=keyway_depth)
+        return cls(radius=bore / 2.0)
+
+    @property
+    def has_keyway(self) -> bool:
+        """Whether the outline includes a keyway."""
+        return self.keyway_width > 0.0 and self.keyway_depth > 0.0
+
+    @property
+    def _half_angle(self) -> float:
+        """Half the angle δ the keyway cuts out of the bore circle [rad]: sin δ = w / 2r."""
+        return math.asin(self.keyway_width / (2.0 * self.radius))
+
+    @property
+    def _corner_y(self) -> float:
+        """Height y₀ = r cos δ where the keyway sides meet the bore circle [mm]."""
+        return self.radius * math.cos(self._half_angle)
+
+    @property
+    def area(self) -> float:
+        """Exact area of the hole [mm²].
+
+        Notes
+        -----
+        Disc plus keyway rectangle above the chord y = y₀, minus the circular
+        cap they share: πr² + w(r + d − y₀) − (r²δ − (w/2)y₀).
+        """
+        r, w, d = self.radius, self.keyway_width, self.keyway_depth
+        disc = math.pi * r * r
+        if not self.has_keyway:
+            return disc
+        y0, delta = self._corner_y, self._half_angle
+        cap = r * r * delta - 0.5 * w * y0
+        return disc + w * (r + d - y0) - cap
+
+    @property
+    def perimeter(self) -> float:
+        """Exact length of the outline [mm]."""
+        r, w, d = self.radius, self.keyway_width, self.keyway_depth
+        if not self.has_keyway:
+            return 2.0 * math.pi * r
+        return r * (2.0 * math.pi - 2.0 * self._half_angle) + 2.0 * (r + d - self._corner_y) + w
+
+    @property
+    def reach(self) -> float:
+        """Largest distance of the outline from the cam axis [mm]."""
+        if not self.has_keyway:
+            return self.radius
+        return math.hypot(self.radius + self.keyway_depth, 0.5 * self.keyway_width)
+
+    def bulge_vertices(self) -> list[tuple[float, float, float]]:
+        """Counter-clockwise ``(x, y, bulge)`` vertices of the keyed outline for an LWPOLYLINE.
+
+        The four keyway corners are exact; the bore arc from the last corner
+        back to the first is one bulge, tan(θ/4) for its included angle θ.
+        Only for a bore with a keyway (a plain bore is a CIRCLE).
+        """
+        if not self.has_keyway:
+            raise ValueError("a plain bore is written as a circle")
+        r, w, d = self.radius, self.keyway_width, self.keyway_depth
+        y0, delta = self._corner_y, self._half_angle
+        sweep = 2.0 * math.pi - 2.0 * delta
+        half = 0.5 * w
+        return [
+            (half, y0, 0.0),
+            (half, r + d, 0.0),
+            (-half, r + d, 0.0),
+            (-half, y0, math.tan(sweep / 4.0)),
+        ]
+
+    def polygon(self, chord_tolerance: float) -> FloatArray:
+        """Counter-clockwise polygon of the outline within ``chord_tolerance`` [mm].
+
+        Returns
+        -------
+        FloatArray
+            (n, 2) vertices [mm], inscribed in the arc, keyway corners exact;
+            read-only.
+        """
+        r = self.radius
+        if not self.has_keyway:
+            n = circle_segments(r, chord_tolerance)
+            t = 2.0 * math.pi * np.arange(n) / n
+            points = np.column_stack((r * np.cos(t), r * np.sin(t)))
+        else:
+            corners = np.array([(x, y) for x, y, _ in self.bulge_vertices()])
+            delta = self._half_angle
+            sweep = 2.0 * math.pi - 2.0 * delta
+            n = circle_segments(r, chord_tolerance, sweep)
+            t = 0.5 * math.pi + delta + sweep * np.arange(1, n) / n
+            arc = np.column_stack((r * np.cos(t), r * np.sin(t)))
+            points = np.vstack((corners, arc))
+        points = np.ascontiguousarray(points, dtype=float)
+        readonly(points)
+        return points
