@@ -1,0 +1,499 @@
+"""Self-contained HTML reports of one design, or several side by side.
+
+:func:`render_report` turns an :class:`~camcad.pipeline.Analysis` into one
+HTML page that opens offline: warnings first, the key numbers at a glance,
+the figures (PNG, embedded as base64 ``data:`` URIs) and the full tables of
+``summary.json``. :func:`render_compare` overlays several designs and tabulates
+them as in Quintero & Vanegas (2016), section 5. Every piece of text is
+escaped with :func:`html.escape`; the page has no external references.
+
+References
+----------
+.. [1] Quintero & Vanegas (2016), cam profile design with VAP motion laws
+   (../shared/papers).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from camcad._plots import Plot, compare_plots, report_plots
+from camcad.export.records import write_text
+
+if TYPE_CHECKING:
+    from camcad.pipeline import Analysis
+
+__all__ = [
+    "compare_table",
+    "render_compare",
+    "render_report",
+    "write_compare",
+    "write_report",
+]
+
+_DASH = "—"
+
+_CSS = """
+:root { --ink:#1d2733; --muted:#5b6877; --line:#d8dee6; --bg:#f5f7fa; --card:#fff;
+        --warn:#fff4d6; --warn-edge:#e0a800; --bad:#fde2e1; --bad-edge:#c0392b;
+        --ok:#e3f4e8; --ok-edge:#2e8b57; }
+* { box-sizing: border-box; }
+body { margin:0; font: 14px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, sans-serif;
+       color:var(--ink); background:var(--bg); }
+main { max-width: 1280px; margin: 0 auto; padding: 20px 24px 40px; }
+header h1 { margin: 0 0 4px; font-size: 24px; }
+header p { margin: 0; color: var(--muted); }
+h2 { font-size: 18px; margin: 28px 0 10px; border-bottom: 1px solid var(--line); padding-bottom: 4px; }
+h3 { font-size: 15px; margin: 18px 0 6px; }
+.alert { border-left: 5px solid; border-radius: 4px; padding: 10px 14px; margin: 16px 0 0; }
+.alert h2 { border: 0; margin: 0 0 6px; padding: 0; font-size: 16px; }
+.alert ul, .alert p { margin: 0; padding-left: 20px; }
+.alert p { padding-left: 0; }
+.warn { background: var(--warn); border-color: var(--warn-edge); }
+.bad { background: var(--bad); border-color: var(--bad-edge); }
+.ok { background: var(--ok); border-color: var(--ok-edge); }
+.cards { display: grid; grid-template-columns: repeat(auto-fill, minmax(190px, 1fr)); gap: 10px;
+         margin-top: 16px; }
+.card { background: var(--card); border: 1px solid var(--line); border-radius: 6px; padding: 10px 12px; }
+.card.over { border-color: var(--bad-edge); background: var(--bad); }
+.card .label { color: var(--muted); font-size: 12px; text-transform: uppercase; letter-spacing: .03em; }
+.card .value { font-size: 21px; font-weight: 600; font-variant-numeric: tabular-nums; }
+.card .note { color: var(--muted); font-size: 12px; }
+.plots { display: grid; grid-template-columns: repeat(auto-fit, minmax(520px, 1fr)); gap: 14px; }
+figure { margin: 0; background: var(--card); border: 1px solid var(--line); border-radius: 6px;
+         padding: 10px; }
+figure img { width: 100%; height: auto; display: block; }
+figcaption { color: var(--muted); font-size: 12.5px; margin-top: 6px; }
+figcaption b { color: var(--ink); }
+table { border-collapse: collapse; background: var(--card); margin: 4px 0 10px;
+        font-variant-numeric: tabular-nums; }
+th, td { border: 1px solid var(--line); padding: 4px 9px; text-align: left; vertical-align: top; }
+th { background: #eef2f6; font-weight: 600; }
+td.num { text-align: right; white-space: nowrap; }
+td code, th code { font-size: 12.5px; }
+.tables { display: grid; grid-template-columns: repeat(auto-fit, minmax(420px, 1fr)); gap: 0 24px; }
+.wide { grid-column: 1 / -1; overflow-x: auto; }
+footer { margin-top: 30px; color: var(--muted); font-size: 12px; }
+"""
+
+
+# ---------------------------------------------------------------------------
+# small formatting helpers
+
+
+def _e(text: object) -> str:
+    """Escaped text."""
+    return html.escape(str(text), quote=True)
+
+
+def _num(value: Any, spec: str = ".6g") -> str:
+    """A number for a table: fixed format, ``—`` for None or non-finite values."""
+    if value is None:
+        return _DASH
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    f = float(value)
+    return format(f, spec) if math.isfinite(f) else _DASH
+
+
+def _finite(values: Any) -> np.ndarray:
+    arr = np.asarray(values, dtype=float).ravel()
+    return arr[np.isfinite(arr)]
+
+
+def _peak(values: Any, fn: Callable[[np.ndarray], Any] = np.max) -> float | None:
+    arr = _finite(values)
+    return float(fn(arr)) if arr.size else None
+
+
+def _img(plot: Plot) -> str:
+    data = base64.b64encode(plot.png).decode("ascii")
+    return (
+        f'<figure id="plot-{_e(plot.key)}"><img alt="{_e(plot.title)}" '
+        f'src="data:image/png;base64,{data}">'
+        f"<figcaption><b>{_e(plot.title)}.</b> {_e(plot.caption)}</figcaption></figure>"
+    )
+
+
+def _page(title: str, body: str) -> str:
+    return (
+        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
+        f"<title>{_e(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n<main>\n"
+        f"{body}\n</main>\n</body>\n</html>\n"
+    )
+
+
+def _looks_numeric(cell: str) -> bool:
+    """Whether an escaped cell is a single number (it is then right-aligned)."""
+    try:
+        float(cell.replace("−", "-"))
+    except ValueError:
+        return cell == _DASH
+    return True
+
+
+def _table(header: Sequence[str] | None, rows: Sequence[Sequence[str]]) -> str:
+    """A table of already escaped cells; numeric cells are right-aligned."""
+    out = ["<table>"]
+    if header is not None:
+        out.append("<tr>" + "".join(f"<th>{h}</th>" for h in header) + "</tr>")
+    for row in rows:
+        cells = [f'<td class="num">{c}</td>' if _looks_numeric(c) else f"<td>{c}</td>" for c in row]
+        out.append("<tr>" + "".join(cells) + "</tr>")
+    out.append("</table>")
+    return "".join(out)
+
+
+def _is_records(value: Any) -> bool:
+    return isinstance(value, (list, tuple)) and bool(value) and all(isinstance(v, Mapping) for v in value)
+
+
+def _cell(value: Any) -> str:
+    """An escaped table cell for any summary value."""
+    if isinstance(value, Mapping):
+        return _mapping_table(value)
+    if _is_records(value):
+        return _records_table(value)
+    if isinstance(value, (list, tuple)):
+        return _e(", ".join(_cell_text(v) for v in value)) if value else _DASH
+    return _e(_cell_text(value))
+
+
+def _cell_text(value: Any) -> str:
+    if value is None or isinstance(value, (bool, int, float, np.integer, np.floating)):
+        return _num(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_cell_text(v) for v in value) + "]"
+    return str(value)
+
+
+def _mapping_table(mapping: Mapping[str, Any], *, skip: Sequence[str] = ()) -> str:
+    rows = [[f"<code>{_e(k)}</code>", _cell(v)] for k, v in mapping.items() if k not in skip]
+    return _table(None, rows) if rows else f"<p>{_DASH}</p>"
+
+
+def _records_table(records: Sequence[Mapping[str, Any]]) -> str:
+    keys: list[str] = []
+    for rec in records:
+        keys += [k for k in rec if k not in keys]
+    header = [f"<code>{_e(k)}</code>" for k in keys]
+    rows = [[_cell(rec.get(k)) for k in keys] for rec in records]
+    return _table(header, rows)
+
+
+def _alert(kind: str, title: str, items: Sequence[str], *, anchor: str = "") -> str:
+    """A highlighted box: ``kind`` is ``bad``, ``warn`` or ``ok``; ``items`` plain text."""
+    ident = f' id="{_e(anchor)}"' if anchor else ""
+    if kind == "ok":
+        body = "".join(f"<p>{_e(i)}</p>" for i in items)
+    else:
+        body = "<ul>" + "".join(f"<li>{_e(i)}</li>" for i in items) + "</ul>"
+    return f'<section class="alert {kind}"{ident}><h2>{_e(title)}</h2>{body}</section>'
+
+
+def _alerts(warnings: Sequence[str], violations: Sequence[str]) -> str:
+    out = []
+    if violations:
+        out.append(_alert("bad", "Design limits violated", violations, anchor="violations"))
+    if warnings:
+        out.append(_alert("warn", f"Warnings ({len(warnings)})", warnings, anchor="warnings"))
+    if not out:
+        out.append(_alert("ok", "No warnings", ["Every checked limit is met."], anchor="warnings"))
+    return "\n".join(out)
+
+
+# ---------------------------------------------------------------------------
+# key numbers (shared by the report header and the comparison table)
+
+
+def _key_numbers(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, Any]:
+    """The headline numbers of one design, from its summary with the sampled arrays as fallback."""
+    motion = summary.get("motion", {})
+    geo = summary.get("geometry", {})
+    dyn = summary.get("dynamics", {})
+    fit = summary.get("fit")
+    d = analysis.dynamics
+    return {
+        "lift": motion.get("lift_mm", analysis.cam.program.lift),
+        "v": motion.get("v_max_abs_mm_per_rad", _peak(np.abs(analysis.motion.v))),
+        "a": motion.get("a_max_abs_mm_per_rad2", _peak(np.abs(analysis.motion.a))),
+        "alpha": geo.get(
+            "pressure_angle_max_deg", math.degrees(float(np.abs(analysis.geometry.pressure_angle).max()))
+        ),
+        "alpha_at": geo.get("pressure_angle_max_angle_deg"),
+        "alpha_limit": math.degrees(analysis.geometry.max_pressure_angle),
+        "rho": geo.get("curvature_radius_min_mm"),
+        "rho_at": geo.get("curvature_radius_min_angle_deg"),
+        "torque_max": dyn.get("torque_max_Nmm", _peak(d.torque)),
+        "torque_min": dyn.get("torque_min_Nmm", _peak(d.torque, np.min)),
+        "force_max": dyn.get("contact_force_max_N", _peak(d.contact_force)),
+        "force_min": dyn.get("contact_force_min_N", _peak(d.contact_force, np.min)),
+        "stress": dyn.get("hertz_stress_max_MPa", _peak(d.hertz_stress)),
+        "stress_allowable": analysis.design.dynamics.allowable_stress,
+        "control_points": None if fit is None else fit.get("control_points"),
+        "fit_error": None if fit is None else fit.get("max_error_mm"),
+        "fit_tolerance": None if fit is None else fit.get("tolerance_mm"),
+    }
+
+
+def _card(label: str, value: str, note: str = "", *, over: bool = False) -> str:
+    cls = "card over" if over else "card"
+    note_html = f'<div class="note">{_e(note)}</div>' if note else ""
+    return (
+        f'<div class="{cls}"><div class="label">{_e(label)}</div>'
+        f'<div class="value">{_e(value)}</div>{note_html}</div>'
+    )
+
+
+def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
+    cam = analysis.cam
+    follower = f"roller r = {cam.roller_radius:g} mm" if cam.is_roller else "flat-face follower"
+    if cam.offset_e:
+        follower += f", offset {cam.offset_e:g} mm"
+    alpha_over = k["alpha"] > k["alpha_limit"]
+    alpha_note = f"limit {k['alpha_limit']:.2f}°"
+    if k["alpha_at"] is not None:
+        alpha_note += f", at φ = {k['alpha_at']:.1f}°"
+    rho_note = (
+        f"convex profile, at φ = {k['rho_at']:.1f}°"
+        if k["rho_at"] is not None
+        else "profile has no convex part"
+    )
+    stress_over = (
+        k["stress_allowable"] is not None and k["stress"] is not None and k["stress"] > k["stress_allowable"]
+    )
+    stress_note = (
+        f"allowable {k['stress_allowable']:g} MPa"
+        if k["stress_allowable"] is not None
+        else "no allowable set"
+    )
+    force_over = k["force_min"] is not None and k["force_min"] < analysis.design.dynamics.min_contact_force
+    if k["control_points"] is None:
+        fit_card = _card("NURBS fit", "not run")
+    else:
+        fit_card = _card(
+            "NURBS fit",
+            f"{k['control_points']} control points",
+            f"max error {_num(k['fit_error'], '.3g')} mm (tolerance {_num(k['fit_tolerance'], 'g')} mm)",
+        )
+    cards = [
+        _card("Lift", f"{k['lift']:.3f} mm"),
+        _card("Base radius", f"{cam.base_radius:.3f} mm", follower),
+        _card("Max pressure angle", f"{k['alpha']:.2f}°", alpha_note, over=alpha_over),
+        _card("Min curvature radius", f"{_num(k['rho'], '.3f')} mm", rho_note),
+        _card(
+            "Max torque", f"{_num(k['torque_max'], '.2f')} N·mm", f"min {_num(k['torque_min'], '.2f')} N·mm"
+        ),
+        _card(
+            "Max contact force",
+            f"{_num(k['force_max'], '.3f')} N",
+            f"min {_num(k['force_min'], '.3f')} N",
+            over=force_over,
+        ),
+        _card("Max Hertz stress", f"{_num(k['stress'], '.2f')} MPa", stress_note, over=stress_over),
+        fit_card,
+    ]
+    return '<section class="cards" id="key-numbers">' + "".join(cards) + "</section>"
+
+
+def _program_table(analysis: Analysis) -> str:
+    program = analysis.cam.program
+    rows = []
+    for i, (seg, start) in enumerate(zip(program.segments, program.segment_bounds, strict=True)):
+        law = seg.law.describe() if seg.law is not None else _DASH
+        rows.append(
+            [
+                _e(i),
+                _e(seg.kind.value),
+                _e(_num(math.degrees(start), ".2f")),
+                _e(_num(math.degrees(seg.span), ".2f")),
+                _e(_num(seg.lift, ".3f")),
+                _e(law),
+            ]
+        )
+    header = ["#", "segment", "start [°]", "span [°]", "lift [mm]", "law"]
+    return _table(header, rows)
+
+
+def _design_table(analysis: Analysis) -> str:
+    design, cam = analysis.design, analysis.cam
+    spec = design.cam
+    rows = [
+        ("follower", design.follower.kind.value),
+        ("base radius [mm]", _num(spec.base_radius)),
+        ("roller radius [mm]", _num(cam.roller_radius) if cam.is_roller else _DASH),
+        ("follower offset [mm]", _num(cam.offset_e)),
+        ("rotation", spec.rotation.value),
+        ("speed [rpm]", _num(spec.speed_rpm)),
+        ("thickness [mm]", _num(spec.thickness)),
+        ("bore diameter [mm]", _num(spec.bore)),
+        ("max pressure angle [°]", _num(math.degrees(spec.max_pressure_angle))),
+    ]
+    return _table(None, [[_e(a), _e(b)] for a, b in rows])
+
+
+def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
+    out = ['<section class="tables" id="tables">']
+    out.append(f"<div><h3>Design</h3>{_design_table(analysis)}</div>")
+    out.append(f"<div><h3>Motion program</h3>{_program_table(analysis)}</div>")
+    motion = summary.get("motion", {})
+    out.append(f"<div><h3>Motion</h3>{_mapping_table(motion, skip=('joints',))}</div>")
+    for name in ("geometry", "dynamics", "fit", "gcode"):
+        section = summary.get(name)
+        if section is None:
+            continue
+        title = {"gcode": "G-code"}.get(name, name.capitalize())
+        body = _mapping_table(section, skip=("warnings",)) if isinstance(section, Mapping) else _cell(section)
+        out.append(f'<div id="table-{name}"><h3>{_e(title)}</h3>{body}</div>')
+    if analysis.timings:
+        rows = [[_e(k), _e(_num(v, ".3f"))] for k, v in analysis.timings.items()]
+        out.append(f"<div><h3>Timings [s]</h3>{_table(None, rows)}</div>")
+    joints = motion.get("joints")
+    if joints:
+        out.append(
+            f'<div class="wide" id="table-joints"><h3>Motion joints</h3>{_records_table(joints)}</div>'
+        )
+    out.append("</section>")
+    return "\n".join(out)
+
+
+# ---------------------------------------------------------------------------
+# public API
+
+
+def render_report(analysis: Analysis) -> str:
+    """The HTML report of one analysed design.
+
+    Parameters
+    ----------
+    analysis
+        The result of :func:`camcad.pipeline.analyse`.
+
+    Returns
+    -------
+    str
+        A complete, self-contained HTML page: warnings, key numbers, figures
+        (motion, pressure angle, curvature, dynamics and the profile to scale,
+        as embedded PNG) and the tables of ``summary.json``. Pure: writes nothing.
+    """
+    summary = analysis.summary()
+    name = analysis.design.cam.name
+    source = analysis.design.source
+    version = summary.get("camcad_version", "")
+    sub = [f"source: {source}" if source else "", f"speed {analysis.design.cam.speed_rpm:g} rpm"]
+    header = f"<header><h1>{_e(name)}</h1><p>{_e(' · '.join(s for s in sub if s))}</p></header>"
+    plots = "".join(_img(p) for p in report_plots(analysis))
+    body = "\n".join(
+        [
+            header,
+            _alerts(analysis.warnings, analysis.violations),
+            _cards(analysis, _key_numbers(analysis, summary)),
+            f'<h2>Plots</h2>\n<section class="plots" id="plots">{plots}</section>',
+            "<h2>Tables</h2>",
+            _summary_tables(analysis, summary),
+            f"<footer>camcad {_e(version)} · angles in degrees, lengths in mm</footer>",
+        ]
+    )
+    return _page(f"camcad report: {name}", body)
+
+
+def write_report(analysis: Analysis, path: str | Path) -> Path:
+    """Atomically write :func:`render_report` to ``path``; return the path."""
+    return write_text(path, render_report(analysis))
+
+
+_COMPARE_ROWS: tuple[tuple[str, str, str], ...] = (
+    ("lift [mm]", "lift", ".3f"),
+    ("max |v| [mm/rad]", "v", ".3f"),
+    ("max |a| [mm/rad²]", "a", ".3f"),
+    ("max pressure angle [°]", "alpha", ".2f"),
+    ("min curvature radius [mm]", "rho", ".3f"),
+    ("max torque [N·mm]", "torque_max", ".2f"),
+    ("min torque [N·mm]", "torque_min", ".2f"),
+    ("max contact force [N]", "force_max", ".3f"),
+    ("max Hertz stress [MPa]", "stress", ".2f"),
+    ("fit control points", "control_points", "d"),
+)
+
+
+def _names(analyses: Sequence[Analysis]) -> list[str]:
+    """Design names, numbered when two designs share one."""
+    names = [a.design.cam.name for a in analyses]
+    return [f"{n} ({i + 1})" if names.count(n) > 1 else n for i, n in enumerate(names)]
+
+
+def compare_table(analyses: Sequence[Analysis]) -> list[list[str]]:
+    """The side-by-side table of several designs (Quintero & Vanegas 2016, section 5).
+
+    Returns
+    -------
+    list[list[str]]
+        A header row (``"quantity"`` then each design name) and one row per
+        quantity: lift, max |v|, max |a|, max pressure angle, min curvature
+        radius, max and min torque, max contact force, max Hertz stress and
+        fit control points. Plain, unescaped strings in a fixed number format;
+        ``—`` where a value does not exist (no fit, no convex part).
+    """
+    keys = [_key_numbers(a, a.summary()) for a in analyses]
+    table = [["quantity", *_names(analyses)]]
+    for label, key, spec in _COMPARE_ROWS:
+        table.append([label, *(_num(k[key], spec) for k in keys)])
+    return table
+
+
+def render_compare(analyses: Sequence[Analysis]) -> str:
+    """An HTML page comparing several analysed designs.
+
+    Parameters
+    ----------
+    analyses
+        Two or more analyses (one also works).
+
+    Returns
+    -------
+    str
+        A self-contained page: the table of :func:`compare_table`, the
+        warnings of each design, and overlaid plots of s, v, a, pressure
+        angle, contact force and torque against the cam angle plus the
+        profiles to scale.
+    """
+    if not analyses:
+        raise ValueError("render_compare needs at least one analysis")
+    names = _names(analyses)
+    table = compare_table(analyses)
+    header = [_e(h) for h in table[0]]
+    rows = [[_e(c) for c in row] for row in table[1:]]
+    alerts = []
+    for name, analysis in zip(names, analyses, strict=True):
+        findings = [*(f"limit violated: {v}" for v in analysis.violations), *analysis.warnings]
+        if findings:
+            alerts.append(_alert("bad" if analysis.violations else "warn", name, findings))
+    if not alerts:
+        alerts.append(_alert("ok", "No warnings", ["Every design meets its checked limits."]))
+    plots = "".join(_img(p) for p in compare_plots(analyses, names))
+    body = "\n".join(
+        [
+            f"<header><h1>Comparison of {len(analyses)} cam designs</h1>"
+            f"<p>{_e(' · '.join(names))}</p></header>",
+            *alerts,
+            f'<h2>Side by side</h2><section class="wide" id="compare-table">{_table(header, rows)}</section>',
+            f'<h2>Plots</h2>\n<section class="plots" id="plots">{plots}</section>',
+            "<footer>camcad · angles in degrees, lengths in mm</footer>",
+        ]
+    )
+    return _page("camcad comparison", body)
+
+
+def write_compare(analyses: Sequence[Analysis], path: str | Path) -> Path:
+    """Atomically write :func:`render_compare` to ``path``; return the path."""
+    return write_text(path, render_compare(analyses))
