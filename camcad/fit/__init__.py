@@ -1,0 +1,23 @@
+"""Certified B-spline fit of the cam profile for CAD export.
+
+The profile is fitted by a periodic cubic B-spline by least squares over
+chord-length parameters (Quang & Hung 2015, eqs. 6–10), with knots at the
+motion breakpoints and the fewest control points whose certified distance to
+the exact profile is below the tolerance. The periodic curve converts exactly
+to a clamped closed curve and to a ``geomdl`` curve for export.
+"""
+
+from __future__ import annotations
+
+from camcad.fit._profile import ProfileFit, fit_points, fit_profile
+from camcad.fit.bspline import clamped_from_periodic, to_geomdl
+from camcad.fit.curve import BSplineCurve
+
+__all__ = [
+    "BSplineCurve",
+    "ProfileFit",
+    "clamped_from_periodic",
+    "fit_points",
+    "fit_profile",
+    "to_geomdl",
+]

@@ -1,0 +1,561 @@
+"""Least-squares B-spline kernels: basis, periodic/clamped fits, knot insertion.
+
+The numerics are hand-written on purpose. geomdl is pure Python: its
+``fitting.approximate_curve`` builds and factors a dense matrix in Python loops
+and takes seconds for 3600 points, while the profile fit solves dozens of
+least-squares problems. scipy has no periodic least-squares spline with
+prescribed multiple knots (``scipy.interpolate.make_lsq_spline`` is clamped and
+non-periodic, ``splrep(per=1)`` chooses its own knots). Here the basis is a
+vectorised Cox–de Boor recursion, the normal equations are assembled per knot
+span in O(n p²) (plus an O(K²) zero fill for K control points) and solved as a
+(cyclic) banded SPD system in O(K p²), so one solve costs about half a
+millisecond for 3600 samples.
+
+References
+----------
+.. [1] Piegl & Tiller (1997), The NURBS Book, 2nd ed., Springer.
+   doi:10.1007/978-3-642-59223-2
+.. [2] Quang & Hung (2015), Computer aided cam design of roller-follower cam
+   mechanism (../shared/papers/002_3938fa916e46e710.txt).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from camcad._typing import FloatArray, readonly
+from camcad.fit.curve import BSplineCurve
+
+if TYPE_CHECKING:
+    from geomdl import BSpline as GeomdlBSpline
+
+__all__ = [
+    "SplineFit",
+    "basis_stages",
+    "chord_length_params",
+    "clamped_from_periodic",
+    "clamped_knot_vector",
+    "curve_derivatives",
+    "derivative_control_points",
+    "find_span",
+    "insert_knot",
+    "lsq_clamped",
+    "lsq_periodic",
+    "periodic_curve",
+    "periodic_knot_vector",
+    "to_geomdl",
+]
+
+IntArray = NDArray[np.intp]
+
+
+def chord_length_params(points: FloatArray, *, closed: bool) -> FloatArray:
+    """Chord-length parameters of ordered points, normalised to a unit period.
+
+    Parameters
+    ----------
+    points
+        (n, 2) ordered points [mm]; for ``closed`` the closing point is not
+        repeated.
+    closed
+        Include the closing chord ``points[-1] → points[0]``.
+
+    Returns
+    -------
+    FloatArray
+        (n,) increasing parameters: ``t[0] = 0``; ``t[-1] = 1`` for open
+        input, ``t[-1] = 1 - |D_0 - D_{n-1}| / L`` for closed input.
+
+    Notes
+    -----
+    t_i = t_{i-1} + |D_i - D_{i-1}| / L, L the polygon length
+    (Quang & Hung 2015, eq. 9; Piegl & Tiller 1997, §9.2.1).
+    """
+    pts = np.asarray(points, dtype=float)
+    ends = np.vstack((pts, pts[:1])) if closed else pts
+    chords = np.hypot(*np.diff(ends, axis=0).T)
+    if np.any(chords <= 0.0):
+        i = int(np.argmin(chords))
+        raise ValueError(f"points {i} and {(i + 1) % len(pts)} coincide; remove repeated points")
+    cum = np.concatenate(([0.0], np.cumsum(chords)))
+    t = cum[: len(pts)] / cum[-1]  # Quang & Hung 2015, eq. 9
+    readonly(t)
+    return t
+
+
+def periodic_knot_vector(tau: FloatArray, degree: int) -> FloatArray:
+    """Extended knot vector of a unit-period spline from one period of knots.
+
+    Parameters
+    ----------
+    tau
+        (K,) knots of one period, ``0 = tau[0] <= ... < 1``, repeated for
+        multiplicity.
+    degree
+        Degree p.
+
+    Returns
+    -------
+    FloatArray
+        (K + 2p + 1,) knots ``tau_i`` for i = -p … K + p with
+        ``tau_{i+K} = tau_i + 1``; the domain is ``[knots[p], knots[K+p]] = [0, 1]``.
+    """
+    tau = np.asarray(tau, dtype=float)
+    k = len(tau)
+    idx = np.arange(-degree, k + degree + 1)
+    knots = tau[idx % k] + idx // k
+    readonly(knots)
+    return knots
+
+
+def clamped_knot_vector(interior: FloatArray, degree: int) -> FloatArray:
+    """Clamped knot vector on [0, 1] with the given interior knots.
+
+    Returns
+    -------
+    FloatArray
+        (len(interior) + 2p + 2,) knots with p + 1 zeros and p + 1 ones
+        (Piegl & Tiller 1997, §2.2).
+    """
+    p1 = degree + 1
+    knots = np.concatenate((np.zeros(p1), np.asarray(interior, dtype=float), np.ones(p1)))
+    readonly(knots)
+    return knots
+
+
+def find_span(knots: FloatArray, degree: int, n_ctrl: int, u: FloatArray) -> IntArray:
+    """Knot-span index i with ``knots[i] <= u < knots[i+1]`` (vectorised).
+
+    ``u`` at the domain end maps to the last non-empty span
+    (Piegl & Tiller 1997, Alg. A2.1).
+    """
+    span = np.searchsorted(knots, u, side="right") - 1
+    return np.clip(span, degree, n_ctrl - 1)  # Piegl & Tiller 1997, Alg. A2.1
+
+
+def basis_stages(
+    knots: FloatArray, degree: int, u: FloatArray, span: IntArray, lowest: int = 0
+) -> list[FloatArray]:
+    """Non-zero B-spline basis functions of degrees ``lowest … degree``.
+
+    Parameters
+    ----------
+    knots
+        Full knot vector.
+    degree
+        Degree p.
+    u
+        (n,) parameters.
+    span
+        (n,) span indices from :func:`find_span`.
+    lowest
+        Lowest degree to return (``degree - d`` gives what the d-th
+        derivative needs).
+
+    Returns
+    -------
+    list of FloatArray
+        Item ``j`` is (q + 1, n) for q = lowest + j: row r holds
+        N_{span-q+r, q}(u) (rows, not columns, so each is contiguous).
+
+    Notes
+    -----
+    The triangular Cox–de Boor scheme of Piegl & Tiller (1997, Alg. A2.2),
+    vectorised over u; each intermediate degree is kept, so derivatives come
+    from the same pass (see :func:`curve_derivatives`).
+    """
+    n = len(u)
+    left = np.zeros((degree + 1, n))
+    right = np.zeros((degree + 1, n))
+    vals = np.zeros((degree + 1, n))
+    vals[0] = 1.0
+    stages = [vals[:1].copy()] if lowest == 0 else []
+    for j in range(1, degree + 1):
+        left[j] = u - np.take(knots, span + 1 - j)
+        right[j] = np.take(knots, span + j) - u
+        saved = np.zeros(n)
+        for r in range(j):
+            temp = vals[r] / (right[r + 1] + left[j - r])  # Piegl & Tiller 1997, Alg. A2.2
+            vals[r] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        vals[j] = saved
+        if j >= lowest:
+            stages.append(vals[: j + 1].copy())
+    return stages
+
+
+def derivative_control_points(
+    knots: FloatArray, degree: int, ctrl: FloatArray, order: int
+) -> list[FloatArray]:
+    """Control points of the derivative curves, indexed like the original ones.
+
+    Item k is (m, dim): Q^(k)_i for i = k … m-1 (rows below k are zero), so
+    C^(k)(u) = Σ_i N_{i, p-k}(u) Q^(k)_i on the original knot vector
+    (Piegl & Tiller 1997, §3.3, Alg. A3.3).
+    """
+    out = [np.asarray(ctrl, dtype=float)]
+    m = len(ctrl)
+    for k in range(1, order + 1):
+        prev = out[-1]
+        q = np.zeros_like(prev)
+        i = np.arange(k, m)
+        du = knots[i + degree - k + 1] - knots[i]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            scale = np.where(du > 0, (degree - k + 1) / du, 0.0)  # Piegl & Tiller 1997, §3.3
+        q[k:] = scale[:, None] * (prev[k:] - prev[k - 1 : -1])
+        out.append(q)
+    return out
+
+
+def _combine(basis: FloatArray, first: IntArray, ctrl: FloatArray) -> FloatArray:
+    """Σ_r basis[r] · ctrl[first + r]: (n, dim) points from (q+1, n) basis values.
+
+    Coordinates are gathered one at a time with ``np.take`` (row fancy
+    indexing of an (m, 2) array is several times slower).
+    """
+    out = np.zeros((len(first), ctrl.shape[1]))
+    for d in range(ctrl.shape[1]):
+        col = np.ascontiguousarray(ctrl[:, d])
+        for r in range(basis.shape[0]):
+            out[:, d] += basis[r] * np.take(col, first + r)
+    return out
+
+
+def _derivatives_at(
+    knots: FloatArray, degree: int, ctrl: FloatArray, span: IntArray, stages: list[FloatArray], order: int
+) -> FloatArray:
+    """C … C^(order) at the parameters behind ``span``/``stages`` (lowest stage p − order)."""
+    dctrl = derivative_control_points(knots, degree, ctrl, order)
+    out = np.zeros((order + 1, len(span), ctrl.shape[1]))
+    for k in range(order + 1):
+        q = degree - k
+        out[k] = _combine(stages[-1 - k], span - q, dctrl[k])  # degree p − k basis
+    return out
+
+
+def curve_derivatives(curve: BSplineCurve, u: FloatArray, order: int = 0) -> FloatArray:
+    """Points and derivatives of a B-spline curve at parameters ``u``.
+
+    Parameters
+    ----------
+    curve
+        The curve; periodic curves wrap ``u`` into the domain, clamped ones
+        clip it.
+    u
+        (n,) parameters.
+    order
+        Highest derivative wanted (at most ``degree``).
+
+    Returns
+    -------
+    FloatArray
+        (order + 1, n, 2): C, C', …, C^(order) [mm, mm/unit u, …].
+    """
+    p = curve.degree
+    knots = curve.knots
+    ctrl = curve.control_points
+    a, b = curve.domain
+    u = np.asarray(u, dtype=float)
+    u = a + np.mod(u - a, b - a) if curve.periodic else np.clip(u, a, b)
+    span = find_span(knots, p, len(ctrl), u)
+    order = min(order, p)
+    stages = basis_stages(knots, p, u, span, lowest=p - order)
+    return _derivatives_at(knots, p, ctrl, span, stages, order)
+
+
+def _normal_equations(
+    span: IntArray, basis: FloatArray, data: FloatArray, degree: int, n_cols: int, fold: int | None
+) -> tuple[FloatArray, FloatArray]:
+    """Assemble NᵀN and NᵀD span by span (``span`` must be non-decreasing).
+
+    ``basis`` is (p + 1, n); the column of row r is ``span - p + r``, taken
+    modulo ``fold`` for a periodic spline (the last p extended control points
+    are the first p). The (p + 1)(p + 2)/2 distinct products are summed per
+    span with ``np.add.reduceat`` and scattered with ``np.bincount``, so the
+    cost is O(n p²) on contiguous rows.
+    """
+    starts = np.flatnonzero(np.r_[True, np.diff(span) != 0])
+    r_idx, q_idx = np.triu_indices(degree + 1)
+    gram = np.add.reduceat(basis[r_idx] * basis[q_idx], starts, axis=1)  # (pairs, spans)
+    rhs = np.add.reduceat(basis[:, None, :] * data.T[None, :, :], starts, axis=2)  # (p+1, dim, spans)
+    col = span[starts] - degree + np.arange(degree + 1)[:, None]  # (p+1, spans)
+    if fold is not None:
+        col %= fold
+    flat = (col[r_idx] * n_cols + col[q_idx]).ravel()
+    upper = np.bincount(flat, gram.ravel(), n_cols * n_cols).reshape(n_cols, n_cols)
+    ntn = upper + upper.T - np.diag(np.diag(upper))  # r = q pairs are on the diagonal once
+    ntd = np.stack(
+        [np.bincount(col.ravel(), rhs[:, d, :].ravel(), n_cols) for d in range(data.shape[1])], axis=1
+    )
+    return ntn, ntd
+
+
+def _banded_upper(mat: FloatArray, bandwidth: int) -> FloatArray:
+    """Upper banded storage ``ab[w + i - j, j] = a[i, j]`` for ``solveh_banded``."""
+    n = mat.shape[0]
+    ab = np.zeros((bandwidth + 1, n))
+    for d in range(bandwidth + 1):
+        ab[bandwidth - d, d:] = np.diagonal(mat, d)
+    return ab
+
+
+def _solve_cyclic_spd(mat: FloatArray, rhs: FloatArray, bandwidth: int) -> FloatArray:
+    """Solve an SPD cyclic-banded system in O(K w²).
+
+    The leading (K - w) block is banded (a principal submatrix, so SPD); the
+    last w unknowns are eliminated through their w × w Schur complement.
+    """
+    k = mat.shape[0]
+    w = bandwidth
+    if k <= 3 * w + 1:
+        return np.asarray(scipy.linalg.cho_solve(scipy.linalg.cho_factor(mat), rhs))
+    s = k - w
+    a11 = _banded_upper(mat[:s, :s], w)
+    a12 = mat[:s, s:]
+    sol = scipy.linalg.solveh_banded(a11, np.hstack((rhs[:s], a12)), check_finite=False)
+    y, z = sol[:, : rhs.shape[1]], sol[:, rhs.shape[1] :]
+    schur = mat[s:, s:] - a12.T @ z
+    x2 = np.linalg.solve(schur, rhs[s:] - a12.T @ y)
+    return np.vstack((y - z @ x2, x2))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SplineFit:
+    """A least-squares curve with its points and tangents at the fit parameters.
+
+    Attributes
+    ----------
+    curve
+        The fitted curve (periodic, or clamped open).
+    at_params
+        (n, 2) C(t_i) [mm].
+    tangent_at_params
+        (n, 2) C'(t_i) [mm per unit parameter].
+    """
+
+    curve: BSplineCurve
+    at_params: FloatArray
+    tangent_at_params: FloatArray
+
+
+def lsq_periodic(params: FloatArray, points: FloatArray, tau: FloatArray, degree: int) -> SplineFit:
+    """Least-squares periodic B-spline.
+
+    Parameters
+    ----------
+    params
+        (n,) increasing sample parameters in [0, 1).
+    points
+        (n, 2) samples [mm].
+    tau
+        (K,) knots of one period (see :func:`periodic_knot_vector`).
+    degree
+        Degree p.
+
+    Returns
+    -------
+    SplineFit
+        Periodic curve with K distinct control points (the last p of its
+        ``control_points`` repeat the first p).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        When some knot span holds too few samples (Schoenberg–Whitney fails).
+
+    Notes
+    -----
+    Minimises Σ |C(t_i) − D_i|² over the control points (Quang & Hung 2015,
+    eq. 10, all weights 1) with the periodic basis N_j(u) = Σ_l N_{j+lK}(u),
+    so the curve is C^{p−μ} everywhere, seam included. The normal equations
+    (Piegl & Tiller 1997, §9.4.1) are cyclic banded.
+    """
+    k = len(tau)
+    knots = periodic_knot_vector(tau, degree)
+    span = find_span(knots, degree, k + degree, params)
+    stages = basis_stages(knots, degree, params, span, lowest=degree - 1)
+    ntn, ntd = _normal_equations(span, stages[-1], points, degree, k, fold=k)
+    ctrl = _solve_cyclic_spd(ntn, ntd, degree)
+    curve = periodic_curve(tau, ctrl, degree)
+    values = _derivatives_at(knots, degree, curve.control_points, span, stages, 1)
+    readonly(values)
+    return SplineFit(curve=curve, at_params=values[0], tangent_at_params=values[1])
+
+
+def lsq_clamped(params: FloatArray, points: FloatArray, interior: FloatArray, degree: int) -> SplineFit:
+    """Least-squares clamped B-spline through the end points.
+
+    Parameters
+    ----------
+    params
+        (n,) increasing parameters, ``params[0] = 0``, ``params[-1] = 1``.
+    points
+        (n, 2) samples [mm].
+    interior
+        Interior knots in (0, 1), repeated for multiplicity.
+    degree
+        Degree p.
+
+    Returns
+    -------
+    SplineFit
+        Clamped curve with len(interior) + p + 1 control points; the first
+        and last equal the first and last sample.
+
+    Notes
+    -----
+    End points are interpolated and the rest fitted in the least-squares
+    sense (Piegl & Tiller 1997, §9.4.1, eqs. 9.63–9.67; Quang & Hung 2015,
+    eq. 10 "always gets through the beginning point and the ending point").
+    """
+    knots = clamped_knot_vector(interior, degree)
+    m = len(knots) - degree - 1
+    span = find_span(knots, degree, m, params)
+    stages = basis_stages(knots, degree, params, span, lowest=degree - 1)
+    ntn, ntd = _normal_equations(span, stages[-1], points, degree, m, fold=None)
+    d0, d1 = points[0], points[-1]
+    rhs = ntd[1:-1] - np.outer(ntn[1:-1, 0], d0) - np.outer(ntn[1:-1, -1], d1)  # R_k, P&T 1997, eq. 9.63
+    inner = scipy.linalg.solveh_banded(_banded_upper(ntn[1:-1, 1:-1], degree), rhs, check_finite=False)
+    ctrl = np.vstack((d0, inner, d1))
+    readonly(ctrl)
+    curve = BSplineCurve(degree=degree, knots=knots, control_points=ctrl, periodic=False)
+    values = _derivatives_at(knots, degree, ctrl, span, stages, 1)
+    readonly(values)
+    return SplineFit(curve=curve, at_params=values[0], tangent_at_params=values[1])
+
+
+def periodic_curve(tau: FloatArray, ctrl: FloatArray, degree: int) -> BSplineCurve:
+    """The periodic :class:`BSplineCurve` of one period's knots and distinct control points."""
+    knots = periodic_knot_vector(tau, degree)
+    cps = np.vstack((ctrl, ctrl[:degree]))
+    readonly(cps)
+    return BSplineCurve(degree=degree, knots=knots, control_points=cps, periodic=True)
+
+
+def insert_knot(
+    knots: FloatArray, ctrl: FloatArray, degree: int, u: float, times: int
+) -> tuple[FloatArray, FloatArray]:
+    """Insert knot ``u`` ``times`` times without changing the curve.
+
+    Parameters
+    ----------
+    knots
+        Full knot vector.
+    ctrl
+        (m, dim) control points.
+    degree
+        Degree p.
+    u
+        Knot value inside the domain.
+    times
+        r, with r + s <= p for the multiplicity s that ``u`` already has.
+
+    Returns
+    -------
+    tuple of FloatArray
+        New knots (len + r,) and control points (m + r, dim).
+
+    Notes
+    -----
+    Boehm's algorithm in the form of Piegl & Tiller (1997, Alg. A5.1).
+    """
+    p = degree
+    up = np.asarray(knots, dtype=float)
+    pw = np.asarray(ctrl, dtype=float)
+    k = int(np.searchsorted(up, u, side="right") - 1)
+    s = int(np.count_nonzero(up == u))
+    r = times
+    if r <= 0:
+        return up.copy(), pw.copy()
+    if r + s > p:
+        raise ValueError(f"cannot insert knot {u} {r} times: multiplicity {s} + {r} exceeds degree {p}")
+    n_old = len(pw)
+    uq = np.concatenate((up[: k + 1], np.full(r, u), up[k + 1 :]))
+    qw = np.zeros((n_old + r, pw.shape[1]))
+    qw[: k - p + 1] = pw[: k - p + 1]
+    qw[k - s + r :] = pw[k - s :]
+    rw = pw[k - p : k - s + 1].copy()
+    last = k - p
+    for j in range(1, r + 1):
+        last = k - p + j
+        for i in range(p - j - s + 1):
+            alpha = (u - up[last + i]) / (up[i + k + 1] - up[last + i])  # P&T 1997, Alg. A5.1
+            rw[i] = alpha * rw[i + 1] + (1.0 - alpha) * rw[i]
+        qw[last] = rw[0]
+        qw[k + r - j - s] = rw[p - j - s]
+    for i in range(last + 1, k - s):
+        qw[i] = rw[i - last]
+    return uq, qw
+
+
+def clamped_from_periodic(curve: BSplineCurve) -> BSplineCurve:
+    """Exact clamped form of a periodic curve, opened at the seam ``u = knots[p]``.
+
+    Parameters
+    ----------
+    curve
+        Periodic curve (``periodic=True``).
+
+    Returns
+    -------
+    BSplineCurve
+        Clamped curve on the same domain whose last control point equals the
+        first; it evaluates to the same points (to rounding, ~1e-13 mm).
+
+    Notes
+    -----
+    The seam knot is raised to multiplicity p at both ends of the domain by
+    knot insertion (Piegl & Tiller 1997, Alg. A5.1); the control points
+    outside the domain are then dropped and the end knots clamped
+    (multiplicity p + 1, which does not change the curve on the domain).
+    """
+    if not curve.periodic:
+        return curve
+    p = curve.degree
+    a, b = curve.domain
+    knots = np.asarray(curve.knots, dtype=float)
+    ctrl = np.asarray(curve.control_points, dtype=float)
+    for value in (a, b):
+        s = int(np.count_nonzero(knots == value))
+        knots, ctrl = insert_knot(knots, ctrl, p, value, max(p - s, 0))
+    first_a = int(np.searchsorted(knots, a, side="left"))
+    first_b = int(np.searchsorted(knots, b, side="left"))
+    cps = ctrl[first_a - 1 : first_b].copy()
+    cps[-1] = cps[0]  # closed: C(b) = C(a) exactly
+    new_knots = np.concatenate(([a], knots[first_a : first_b + p], [b]))
+    readonly(cps, new_knots)
+    return BSplineCurve(degree=p, knots=new_knots, control_points=cps, periodic=False)
+
+
+def to_geomdl(curve: BSplineCurve) -> GeomdlBSpline.Curve:
+    """The curve as a ``geomdl.BSpline.Curve`` (clamped form, knots on [0, 1]).
+
+    Parameters
+    ----------
+    curve
+        Periodic or clamped curve; periodic curves are converted with
+        :func:`clamped_from_periodic`.
+
+    Returns
+    -------
+    geomdl.BSpline.Curve
+        Degree, control points and knot vector normalised to [0, 1]:
+        geomdl parameter v maps to ours by u = a + v (b - a).
+    """
+    from geomdl import BSpline as GeomdlBSpline
+
+    clamped = clamped_from_periodic(curve)
+    a, b = clamped.domain
+    knots = (np.asarray(clamped.knots) - a) / (b - a)
+    knots[: clamped.degree + 1] = 0.0
+    knots[-clamped.degree - 1 :] = 1.0
+    out = GeomdlBSpline.Curve(normalize_kv=False)
+    out.degree = clamped.degree
+    out.ctrlpts = np.asarray(clamped.control_points, dtype=float).tolist()
+    out.knotvector = knots.tolist()
+    return out
