@@ -1,0 +1,106 @@
+"""Benchmark of the G-code toolpath: biarc blocks against G1-only paths at the same tolerance.
+
+Run ``python benchmarks/gcode.py [tolerance_mm]`` (default 0.005); prints a
+Markdown table per shipped sample (``samples/*.toml``):
+
+- contour blocks: one finishing contour (leads excluded) written with biarcs,
+  with greedy maximal G1 chords (the fewest an interpolating G1 path can
+  have at this tolerance, found and measured by the same machinery) and
+  with uniform φ-steps (what a spline-to-G1 post-processor typically
+  writes: the coarsest uniform step whose chords stay in tolerance);
+- program blocks: the whole program (all roughing passes, finishing, bore
+  and leads), biarcs against greedy G1;
+- the measured deviation of the written biarc contour and the time to plan
+  (fit, round, measure) the whole program.
+
+Every G1 path meets the same two-way tolerance as the biarcs (fit to 0.8 tol,
+measured after rounding), so the ratios compare like with like.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from camcad.design import load_design
+from camcad.export.gcode import count_blocks, plan_toolpath, render_gcode
+from camcad.export.gcode._contour import offset_curve
+from camcad.export.gcode.biarc import chord_pieces, measure_deviation
+from camcad.geometry.cam import Cam
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def uniform_chords(cam: Cam, radius: float, tol: float) -> int:
+    """Fewest uniform φ-steps whose chords of cam.offset(φ, radius) stay within ``tol`` [mm]."""
+    curve = offset_curve(cam, radius)
+
+    def fits(n: int) -> bool:
+        phi = np.linspace(0.0, 2.0 * math.pi, n + 1)
+        pt, d1, _ = curve(phi)
+        t = d1 / np.linalg.norm(d1, axis=1)[:, None]
+        pieces = chord_pieces(phi[:-1], phi[1:], pt[:-1], t[:-1], pt[1:], t[1:])
+        return bool(measure_deviation(curve, pieces).max() <= tol)
+
+    lo, hi = 8, 16
+    while not fits(hi):
+        lo, hi = hi, 2 * hi
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if fits(mid) else (mid, hi)
+    return hi
+
+
+def main(tolerance: float = 0.005) -> None:
+    """Print the benchmark table for every shipped sample."""
+    rows = []
+    for path in sorted((ROOT / "samples").glob("*.toml")):
+        design = load_design(path)
+        spec = replace(design.gcode, tolerance=tolerance)
+        cam = Cam.from_design(design)
+        kw = {"name": design.cam.name, "thickness": design.cam.thickness, "bore": design.cam.bore}
+        start = time.perf_counter()
+        arcs = plan_toolpath(cam, spec, **kw)
+        elapsed = time.perf_counter() - start
+        lines = plan_toolpath(cam, spec, arcs=False, **kw)
+        uniform = uniform_chords(cam, spec.tool_radius, 0.8 * tolerance)
+        prog_arcs = count_blocks(render_gcode(arcs))
+        prog_lines = count_blocks(render_gcode(lines))
+        rows.append(
+            (
+                path.stem,
+                arcs.contour_blocks,
+                lines.contour_blocks,
+                uniform,
+                lines.contour_blocks / arcs.contour_blocks,
+                uniform / arcs.contour_blocks,
+                prog_arcs,
+                prog_lines,
+                prog_lines / prog_arcs,
+                arcs.max_deviation,
+                elapsed,
+            )
+        )
+    print(f"G-code blocks at tolerance {tolerance:g} mm (contour = one finishing pass, leads excluded)\n")
+    print(
+        "| sample | contour biarc | contour G1 greedy | contour G1 uniform | G1 greedy / biarc "
+        "| G1 uniform / biarc | program biarc | program G1 greedy | program ratio "
+        "| deviation [mm] | plan time [s] |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for r in rows:
+        print(
+            f"| {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]:.1f} | {r[5]:.1f} | {r[6]} | {r[7]} "
+            f"| {r[8]:.1f} | {r[9]:.5f} | {r[10]:.2f} |"
+        )
+
+
+if __name__ == "__main__":
+    main(float(sys.argv[1]) if len(sys.argv) > 1 else 0.005)

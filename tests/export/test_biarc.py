@@ -1,0 +1,159 @@
+"""Biarcs: construction invariants, exact circles, and measured tolerance on analytic curves."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+from scipy.spatial import cKDTree
+
+from camcad.export.gcode.biarc import (
+    biarc_pieces,
+    chord_pieces,
+    fit_curve,
+    measure_deviation,
+    sample_pieces,
+)
+
+
+def ellipse(a: float, b: float):
+    """x = a cos φ, y = b sin φ with its φ-derivatives."""
+
+    def curve(phi):
+        phi = np.asarray(phi, dtype=float)
+        p = np.column_stack((a * np.cos(phi), b * np.sin(phi)))
+        d1 = np.column_stack((-a * np.sin(phi), b * np.cos(phi)))
+        return p, d1, -p
+
+    return curve
+
+
+def wobble(r0: float = 50.0, amp: float = 6.0, k: int = 3):
+    """A star-shaped curve r = r0 + amp cos kφ, with concave stretches when amp·k² is large."""
+
+    def curve(phi):
+        phi = np.asarray(phi, dtype=float)
+        r = r0 + amp * np.cos(k * phi)
+        r1 = -amp * k * np.sin(k * phi)
+        r2 = -amp * k * k * np.cos(k * phi)
+        c, s = np.cos(phi), np.sin(phi)
+        p = np.column_stack((r * c, r * s))
+        d1 = np.column_stack((r1 * c - r * s, r1 * s + r * c))
+        d2 = np.column_stack((r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s))
+        return p, d1, d2
+
+    return curve
+
+
+def unit(angle):
+    return np.column_stack((np.cos(angle), np.sin(angle)))
+
+
+def dense_distance(points, poly):
+    """Distance from points to a dense polyline: the segments beside the 4 nearest vertices."""
+    _, idx = cKDTree(poly).query(points, k=4)
+    best = np.full(len(points), np.inf)
+    for col in range(4):
+        for first in (idx[:, col] - 1, idx[:, col]):
+            j = np.clip(first, 0, len(poly) - 2)
+            a, w = poly[j], poly[j + 1] - poly[j]
+            ww = np.maximum(np.einsum("ij,ij->i", w, w), 1e-300)
+            t = np.clip(np.einsum("ij,ij->i", points - a, w) / ww, 0.0, 1.0)
+            best = np.minimum(best, np.linalg.norm(points - (a + w * t[:, None]), axis=1))
+    return best
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    x=st.floats(1.0, 30.0),
+    y=st.floats(-10.0, 10.0),
+    a0=st.floats(-1.2, 1.2),
+    a1=st.floats(-1.2, 1.2),
+    ratio=st.sampled_from([0.75, 1.0, 1.33]),
+)
+def test_biarc_meets_ends_and_joins_tangentially(x, y, a0, a1, ratio):
+    p0, p1 = np.array([[0.0, 0.0]]), np.array([[x, y]])
+    chord = math.atan2(y, x)
+    t0, t1 = unit(np.array([chord + a0])), unit(np.array([chord + a1]))
+    pc = biarc_pieces(np.zeros(1), np.ones(1), p0, t0, p1, t1, ratio=ratio)
+    assert_allclose(pc.start[0, 0], p0[0], atol=1e-12)
+    assert_allclose(pc.end[0, 1], p1[0], atol=1e-9)
+    assert_allclose(pc.end[0, 0], pc.start[0, 1], atol=0)
+    # both arcs pass through the joint and keep their radius
+    for k in (0, 1):
+        if not pc.line[0, k]:
+            r_a = np.linalg.norm(pc.start[0, k] - pc.center[0, k])
+            r_b = np.linalg.norm(pc.end[0, k] - pc.center[0, k])
+            assert abs(r_a - r_b) <= 1e-9 * max(1.0, r_a)
+    # tangents: the first arc leaves along t0, the second arrives along t1, and they agree at the joint
+
+    def tangent(k, at_end):
+        if pc.line[0, k]:
+            d = pc.end[0, k] - pc.start[0, k]
+            return d / np.linalg.norm(d)
+        p = pc.end[0, k] if at_end else pc.start[0, k]
+        rad = p - pc.center[0, k]
+        left = np.array([-rad[1], rad[0]]) / np.linalg.norm(rad)
+        return left if pc.ccw[0, k] else -left
+
+    assert_allclose(tangent(0, False), t0[0], atol=1e-7)
+    assert_allclose(tangent(1, True), t1[0], atol=1e-7)
+    assert_allclose(tangent(0, True), tangent(1, False), atol=1e-7)
+
+
+def test_circle_is_one_exact_biarc_per_break():
+    circle = ellipse(40.0, 40.0)
+    pieces, dev = fit_curve(circle, np.linspace(0.0, 2 * np.pi, 5), 1e-4)
+    assert len(pieces) == 4
+    assert dev.max() < 1e-9
+    assert_allclose(pieces.r_start, 40.0, rtol=1e-9)
+    assert_allclose(pieces.center.reshape(-1, 2), 0.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("tol", [0.05, 0.005, 0.001], ids=lambda t: f"tol{t:g}")
+@pytest.mark.parametrize("name", ["ellipse", "wobble"])
+def test_fit_stays_within_tolerance_by_independent_measure(name, tol):
+    curve = ellipse(60.0, 35.0) if name == "ellipse" else wobble()
+    pieces, dev = fit_curve(curve, np.linspace(0.0, 2 * np.pi, 5), tol)
+    assert dev.max() <= tol
+    # independent two-way check on dense samples of both curves
+    exact = curve(np.linspace(0.0, 2 * np.pi, 40001))[0]
+    samples = sample_pieces(pieces, 400)  # chord sagitta < 1e-6 mm
+    both = np.vstack(
+        [
+            np.stack([pieces.start[i, k], *samples[i, k], pieces.end[i, k]])
+            for i in range(len(pieces))
+            for k in (0, 1)
+        ]
+    )
+    probe = exact[::3]
+    assert dense_distance(both, exact).max() <= tol * 1.001
+    assert dense_distance(probe, both).max() <= tol * 1.001
+
+
+def test_pieces_are_g1_continuous_across_intervals():
+    pieces, _ = fit_curve(wobble(), np.linspace(0.0, 2 * np.pi, 7), 0.002)
+    assert_allclose(pieces.end[:-1, 1], pieces.start[1:, 0], atol=0)
+    assert_allclose(pieces.end[:, 0], pieces.start[:, 1], atol=0)
+
+
+def test_biarcs_need_far_fewer_blocks_than_chords():
+    curve = ellipse(60.0, 35.0)
+    arcs, _ = fit_curve(curve, np.linspace(0.0, 2 * np.pi, 5), 0.004)
+    chords, _ = fit_curve(curve, np.linspace(0.0, 2 * np.pi, 5), 0.004, arcs=False)
+    assert 2 * len(arcs) * 3 < len(chords)
+
+
+def test_chords_deviation_is_their_sagitta():
+    circle = ellipse(10.0, 10.0)
+    n = 16
+    phi = np.linspace(0.0, 2 * np.pi, n + 1)
+    p, d1, _ = circle(phi)
+    t = d1 / np.linalg.norm(d1, axis=1)[:, None]
+    pc = chord_pieces(phi[:-1], phi[1:], p[:-1], t[:-1], p[1:], t[1:])
+    sagitta = 10.0 * (1.0 - math.cos(math.pi / n))
+    assert_allclose(measure_deviation(circle, pc, samples=101), sagitta, rtol=1e-3)
