@@ -82,8 +82,11 @@ def reference_002(n_ctrl: int = 80) -> str:
     fit = lsq_periodic(params, points, np.arange(n_ctrl) / n_ctrl, 3)
     err = project(fit.curve, points, params).max_error
     ours = fit_profile(
-        phi, points, exact=lambda p: np.asarray(cam.profile(p).point),
-        breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints], tolerance=TOL,
+        phi,
+        points,
+        exact=lambda p: np.asarray(cam.profile(p).point),
+        breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
+        tolerance=TOL,
     )
     return (
         f"002 reference (offset-roller sample, {len(phi)} samples): {n_ctrl} control points, "

@@ -24,6 +24,7 @@ def __getattr__(name: str) -> object:
         return getattr(pipeline, name)
     raise AttributeError(f"module 'camcad' has no attribute {name!r}")
 
+
 __all__ = [
     "LAWS",
     "Analysis",

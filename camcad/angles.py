@@ -30,7 +30,7 @@ def flagged_ranges(phi: FloatArray, mask: np.ndarray) -> list[tuple[float, float
         starts.insert(0, 0)
     if mask[-1]:
         ends.append(len(mask) - 1)
-    runs = [(float(phi[a]), float(phi[b])) for a, b in zip(starts, ends)]
+    runs = [(float(phi[a]), float(phi[b])) for a, b in zip(starts, ends, strict=True)]
     if mask[0] and mask[-1] and len(runs) > 1:
         first, last = runs[0], runs.pop()
         runs[0] = (last[0], first[1])
@@ -39,6 +39,4 @@ def flagged_ranges(phi: FloatArray, mask: np.ndarray) -> list[tuple[float, float
 
 def format_ranges(ranges: list[tuple[float, float]]) -> str:
     """``'12.3°–45.6°, 300.0°–10.0°'`` from ranges in radians."""
-    return ", ".join(
-        f"{math.degrees(a):.1f}°–{math.degrees(b):.1f}°" for a, b in ranges
-    )
+    return ", ".join(f"{math.degrees(a):.1f}°–{math.degrees(b):.1f}°" for a, b in ranges)

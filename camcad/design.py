@@ -33,8 +33,8 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 __all__ = [
     "CamSpec",
     "Design",
-    "Direction",
     "Dialect",
+    "Direction",
     "DxfSpec",
     "DynamicsModel",
     "DynamicsSpec",
@@ -336,9 +336,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "keyway_depth": _Rule("float", 0.0, check=_non_negative),
         "max_pressure_angle": _Rule("float", 30.0, check=_below(90.0, "degrees"), scale=DEG),
         "min_curvature_radius": _Rule("float", None, check=_non_negative),
-        "sample_step_deg": _Rule(
-            "float", 0.1, check=_below(10.0, "degrees"), scale=DEG, attr="sample_step"
-        ),
+        "sample_step_deg": _Rule("float", 0.1, check=_below(10.0, "degrees"), scale=DEG, attr="sample_step"),
     },
     "follower": {
         "type": _Rule("enum", FollowerKind.TRANSLATING_ROLLER, enum=FollowerKind, attr="kind"),
@@ -536,9 +534,7 @@ def _check_program(segments: tuple[SegmentSpec, ...]) -> None:
     total = sum(seg.span for seg in segments) / DEG
     if abs(total - FULL_TURN_DEG) > ANGLE_SUM_TOL_DEG * FULL_TURN_DEG:
         spans = " + ".join(f"{seg.span / DEG:g}" for seg in segments)
-        raise DesignError(
-            "motion", f"segment angles must total 360°, got {spans} = {total:g}°"
-        )
+        raise DesignError("motion", f"segment angles must total 360°, got {spans} = {total:g}°")
     s = 0.0
     for i, seg in enumerate(segments):
         if seg.kind is SegmentKind.RISE:

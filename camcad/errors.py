@@ -64,9 +64,7 @@ class UndercutError(DesignLimitError):
 class GougeError(DesignLimitError):
     """The milling tool is larger than a concave radius of the profile."""
 
-    def __init__(
-        self, message: str, *, phi_range: tuple[float, float], max_tool_radius: float
-    ) -> None:
+    def __init__(self, message: str, *, phi_range: tuple[float, float], max_tool_radius: float) -> None:
         super().__init__(message)
         self.phi_range = phi_range
         self.max_tool_radius = max_tool_radius

@@ -93,9 +93,7 @@ def curve_sample(
     return out
 
 
-def rotate_to_cam(
-    phi: FloatArray, local: FloatArray, sign: float = 1.0
-) -> FloatArray:
+def rotate_to_cam(phi: FloatArray, local: FloatArray, sign: float = 1.0) -> FloatArray:
     """Rotate follower-frame vectors into the cam frame.
 
     The follower frame turns with the cam angle: its y axis is the follower's

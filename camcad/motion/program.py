@@ -149,7 +149,8 @@ class MotionProgram:
     @property
     def lift(self) -> float:
         """Largest displacement of the program [mm]."""
-        ends = [b + (g.lift if g.kind is SegmentKind.RISE else 0.0) for b, g in zip(self.base_s, self.segments)]
+        pairs = zip(self.base_s, self.segments, strict=True)
+        ends = [b + (g.lift if g.kind is SegmentKind.RISE else 0.0) for b, g in pairs]
         return max([*self.base_s, *ends])
 
     @property
@@ -224,7 +225,7 @@ class MotionProgram:
             left = self._evaluate_segment(left_k, np.array([x_left]))
             right = self._evaluate_segment(right_k, np.array([x_right]))
             cleaned = []
-            for order, (l_, r) in enumerate(zip(left[1:], right[1:]), start=1):
+            for order, (l_, r) in enumerate(zip(left[1:], right[1:], strict=True), start=1):
                 value = float(r[0] - l_[0])
                 ref = max(self._derivative_scale(left_k, order), self._derivative_scale(right_k, order))
                 # one-sided limits inside a law are taken ε away: allow for that slope
@@ -255,7 +256,7 @@ class MotionProgram:
 
     def sample_phi(self, step: float) -> FloatArray:
         """Cam angles in [0, 2π): a uniform grid of ``step`` [rad] plus every breakpoint."""
-        n = max(int(math.ceil(TWO_PI / step - 1e-9)), 8)
+        n = max(math.ceil(TWO_PI / step - 1e-9), 8)
         grid = np.linspace(0.0, TWO_PI, n, endpoint=False)
         marks = np.mod([bp.phi for bp in self.breakpoints], TWO_PI)
         phi = np.union1d(grid, marks)

@@ -39,7 +39,7 @@ def test_profile_is_the_envelope_at_roller_distance_from_the_pitch_curve(law, of
     phi = np.linspace(0.0, 2 * math.pi, 97, endpoint=False)
     contact = cam.profile(phi).point
     assert_allclose(pitch_002(cam, phi), cam.pitch(phi).point, atol=1e-12)
-    for f, c in zip(phi, contact):
+    for f, c in zip(phi, contact, strict=True):
         res = minimize_scalar(
             lambda t, c=c: float(np.hypot(*(pitch_002(cam, np.array([t]))[0] - c))),
             bounds=(f - 0.3, f + 0.3),
@@ -66,7 +66,10 @@ def test_every_pitch_point_is_a_roller_radius_from_the_profile_polygon():
 
 
 def test_a_full_dwell_is_a_base_circle():
-    for follower, extra in (("translating-roller", {"roller_radius": 7.0, "offset": 5.0}), ("translating-flat", {})):
+    for follower, extra in (
+        ("translating-roller", {"roller_radius": 7.0, "offset": 5.0}),
+        ("translating-flat", {}),
+    ):
         design = parse_design(
             {
                 "cam": {"base_radius": 33.0},
@@ -174,7 +177,9 @@ def test_hren_cam_has_no_cusp_and_reports_its_face_width():
 
 
 def test_small_base_radius_gives_undercut_with_a_radius_that_works():
-    design = make_design(law="cycloidal", base_radius=5.0, roller_radius=20.0, lift=15.0, spans=(90, 90, 90, 90))
+    design = make_design(
+        law="cycloidal", base_radius=5.0, roller_radius=20.0, lift=15.0, spans=(90, 90, 90, 90)
+    )
     cam = Cam.from_design(design)
     geo = analyse_geometry(cam, max_pressure_angle=math.radians(89))
     assert geo.undercut is not None

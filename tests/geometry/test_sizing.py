@@ -46,6 +46,9 @@ def test_sized_radius_passes_and_a_smaller_one_fails():
     phi = cam.sample_phi()
     for radius, ok in ((result.base_radius, True), (result.base_radius - 0.01, False)):
         m_alpha, m_rho, _, _ = feasible_margins(
-            replace(cam, base_radius=radius), phi, max_pressure_angle=math.radians(25), min_curvature_radius=2.0
+            replace(cam, base_radius=radius),
+            phi,
+            max_pressure_angle=math.radians(25),
+            min_curvature_radius=2.0,
         )
         assert (m_alpha >= 0 and m_rho >= 0) is ok

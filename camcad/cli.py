@@ -1,0 +1,243 @@
+"""The camcad command line: build, check, size, compare, laws.
+
+Exit codes: 0 success, 2 invalid input (usage, unreadable or invalid design,
+unwritable output), 3 a design limit violated (undercut, gouge, jump,
+pressure angle or stress limit), 1 anything unexpected.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from camcad._version import __version__
+from camcad.errors import CamcadError, DesignLimitError, exit_code
+
+__all__ = ["build_parser", "main"]
+
+EXIT_OK, EXIT_UNEXPECTED, EXIT_INVALID, EXIT_LIMIT = 0, 1, 2, 3
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser that exits 2 with one clear line (argparse's own code for usage errors)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(EXIT_INVALID, f"camcad: error: {message} (see '{self.prog} --help')\n")
+
+
+def _progress(quiet: bool):
+    if quiet:
+        return None
+
+    def report(stage: str, seconds: float) -> None:
+        print(f"  {stage:<10} {seconds * 1000:8.1f} ms", file=sys.stderr)
+
+    return report
+
+
+def _cmd_build(args: argparse.Namespace) -> int:
+    from camcad.design import load_design
+    from camcad.pipeline import build
+
+    design = load_design(args.design)
+    only = args.only.split(",") if args.only else None
+    if not args.quiet:
+        print(f"camcad {__version__}: building {design.cam.name!r} from {args.design}", file=sys.stderr)
+    result = build(design, args.output, only=only, progress=_progress(args.quiet))
+    warnings = result.analysis.warnings
+    if not args.quiet:
+        for w in warnings:
+            print(f"warning: {w}", file=sys.stderr)
+        print(f"wrote {len(result.files)} files to {result.outdir}", file=sys.stderr)
+        for path in result.files:
+            print(f"  {path}")
+    return EXIT_OK
+
+
+def _fmt(value: Any, unit: str = "", digits: int = 3) -> str:
+    if value is None:
+        return "—"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, (int,)):
+        return f"{value}{unit}"
+    return f"{value:.{digits}f}{unit}"
+
+
+def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
+    geo, dyn = summary["geometry"], summary["dynamics"]
+    fit = summary.get("fit") or {}
+    limit = math.degrees(design.cam.max_pressure_angle)
+    return [
+        ("lift", _fmt(summary["motion"]["lift_mm"], " mm")),
+        (
+            "max pressure angle",
+            f"{_fmt(geo['pressure_angle_max_deg'], '°', 2)} at "
+            f"{_fmt(geo['pressure_angle_max_angle_deg'], '°', 1)} (limit {limit:g}°)",
+        ),
+        ("min curvature radius", _fmt(geo["curvature_radius_min_mm"], " mm")),
+        ("min concave radius", _fmt(geo["concave_radius_min_mm"], " mm")),
+        ("undercut", _fmt(geo["undercut"])),
+        ("max torque", _fmt(dyn.get("torque_max_Nmm"), " N·mm", 1)),
+        ("max contact force", _fmt(dyn.get("contact_force_max_N"), " N", 2)),
+        ("min contact force", _fmt(dyn.get("contact_force_min_N"), " N", 2)),
+        ("max contact stress", _fmt(dyn.get("hertz_stress_max_MPa"), " MPa", 1)),
+        ("follower jump", _fmt(dyn.get("jump"))),
+        (
+            "fit control points",
+            f"{fit['control_points']} (max error {fit['max_error_mm'] * 1000:.3f} µm)" if fit else "—",
+        ),
+    ]
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from camcad.design import load_design
+    from camcad.errors import FitError, GougeError
+    from camcad.pipeline import analyse
+
+    design = load_design(args.design)
+    violations: list[str] = []
+    extra: list[str] = []
+    try:
+        analysis = analyse(design, strict=False, toolpath=True)
+    except (GougeError, FitError) as err:
+        analysis = analyse(design, strict=False, toolpath=False)
+        violations.append("gouge" if isinstance(err, GougeError) else "fit")
+        extra.append(str(err))
+    summary = analysis.summary()
+    violations = analysis.violations + violations
+    rows = _check_rows(summary, design)
+    width = max(len(k) for k, _ in rows)
+    print(f"{design.cam.name} ({args.design})")
+    for key, value in rows:
+        print(f"  {key:<{width}}  {value}")
+    if analysis.geometry.undercut is not None:
+        from camcad.geometry import undercut_error
+
+        extra.append(str(undercut_error(analysis.geometry, min_curvature_radius=design.min_curvature_radius)))
+    for w in [*analysis.warnings, *extra]:
+        print(f"  warning: {w}")
+    if violations:
+        print(f"design limits violated: {', '.join(dict.fromkeys(violations))}")
+        return EXIT_LIMIT
+    print("all design limits hold")
+    return EXIT_OK
+
+
+def _cmd_size(args: argparse.Namespace) -> int:
+    from camcad.design import load_design
+    from camcad.geometry import Cam, min_base_radius
+
+    design = load_design(args.design)
+    cam = Cam.from_design(design)
+    result = min_base_radius(
+        cam,
+        max_pressure_angle=design.cam.max_pressure_angle,
+        min_curvature_radius=design.min_curvature_radius,
+    )
+    print(f"smallest base radius: {result.base_radius:.3f} mm (design has {design.cam.base_radius:g} mm)")
+    print(f"  limited by {result.limit} at cam angle {math.degrees(result.angle):.1f}°")
+    print(
+        f"  at that radius: max pressure angle {math.degrees(result.pressure_angle_max):.2f}° "
+        f"(limit {math.degrees(design.cam.max_pressure_angle):g}°), "
+        f"min convex curvature radius {result.curvature_radius_min:.3f} mm "
+        f"(limit {design.min_curvature_radius:g} mm)"
+    )
+    return EXIT_OK
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from camcad.design import load_design
+    from camcad.pipeline import analyse
+    from camcad.report import compare_table, write_compare
+
+    analyses = [analyse(load_design(p), strict=False, toolpath=False) for p in args.designs]
+    table = compare_table(analyses)
+    widths = [max(len(row[i]) for row in table) for i in range(len(table[0]))]
+    for row in table:
+        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())
+    if args.output:
+        out = Path(args.output)
+        out.mkdir(parents=True, exist_ok=True)
+        path = write_compare(analyses, out / "compare.html")
+        print(f"wrote {path}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _cmd_laws(args: argparse.Namespace) -> int:
+    from camcad.motion.laws import LAWS
+
+    for info in LAWS.values():
+        params = ", ".join(
+            f"{p.name} ({p.allowed}{'' if p.default is None else f', default {p.default}'})"
+            for p in info.parameters
+        )
+        print(f"{info.name:<20} {info.summary}" + (f"  [parameters: {params}]" if params else ""))
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every subcommand."""
+    parser = _Parser(
+        prog="camcad",
+        description="Disc cams from a motion specification to DXF, STL, G-code and a report.",
+        epilog="Exit codes: 0 ok, 1 unexpected failure, 2 invalid input, 3 design limit violated.",
+    )
+    parser.add_argument("--version", action="version", version=f"camcad {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+
+    p = sub.add_parser("build", help="analyse a design and write every shop file and the report")
+    p.add_argument("design", help="design file (TOML)")
+    p.add_argument("-o", "--output", required=True, help="output folder (created; files replaced)")
+    p.add_argument(
+        "--only",
+        help="comma-separated outputs to write: tables, dxf, stl, gcode, report (summary.json always)",
+    )
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    p.set_defaults(handler=_cmd_build)
+
+    p = sub.add_parser("check", help="validate and analyse without writing; exit 3 if a limit is violated")
+    p.add_argument("design", help="design file (TOML)")
+    p.set_defaults(handler=_cmd_check)
+
+    p = sub.add_parser("size", help="smallest base radius meeting the pressure-angle and curvature limits")
+    p.add_argument("design", help="design file (TOML)")
+    p.set_defaults(handler=_cmd_size)
+
+    p = sub.add_parser("compare", help="compare designs side by side (table, and overlay plots with -o)")
+    p.add_argument("designs", nargs="+", help="design files (TOML)")
+    p.add_argument("-o", "--output", help="folder for compare.html")
+    p.set_defaults(handler=_cmd_compare)
+
+    p = sub.add_parser("laws", help="list the motion laws and their parameters")
+    p.set_defaults(handler=_cmd_laws)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the camcad command line and return the exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.handler(args))
+    except KeyboardInterrupt:
+        print("camcad: interrupted", file=sys.stderr)
+        return 130
+    except DesignLimitError as err:
+        print(f"camcad: design limit: {err}", file=sys.stderr)
+        return exit_code(err)
+    except CamcadError as err:
+        print(f"camcad: error: {err}", file=sys.stderr)
+        return exit_code(err)
+    except OSError as err:
+        where = f": {err.filename}" if err.filename else ""
+        print(f"camcad: error: {err.strerror or err}{where}", file=sys.stderr)
+        return exit_code(err)
+    except Exception as err:  # the one place that maps surprises to exit 1
+        print(f"camcad: unexpected error: {type(err).__name__}: {err}", file=sys.stderr)
+        print("camcad: please report this with your design file", file=sys.stderr)
+        return EXIT_UNEXPECTED

@@ -1,0 +1,438 @@
+"""Design → analysis → files, with an all-or-nothing output folder.
+
+:func:`analyse` runs the stages motion → geometry → dynamics → fit (and the
+toolpath plan, which checks for gouge) and returns an :class:`Analysis`;
+:func:`build` writes the files into a temporary folder and moves them into
+the output folder only when every stage has succeeded.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import tempfile
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from camcad._version import __version__
+from camcad.design import Design, load_design
+from camcad.dynamics import DynamicsResult, analyse_dynamics
+from camcad.errors import DesignError
+from camcad.export.records import write_csv, write_json, write_text
+from camcad.fit import ProfileFit, fit_profile
+from camcad.geometry import Cam, GeometryAnalysis, analyse_geometry, undercut_error
+from camcad.motion.program import Motion
+
+__all__ = [
+    "OUTPUT_GROUPS",
+    "Analysis",
+    "BuildResult",
+    "Progress",
+    "Project",
+    "analyse",
+    "build",
+    "load",
+    "motion_summary",
+]
+
+Progress = Callable[[str, float], None]
+"""Called after each stage with its name and its duration [s]."""
+
+OUTPUT_GROUPS: dict[str, tuple[str, ...]] = {
+    "tables": ("motion.csv", "profile.csv", "dynamics.csv", "points.csv", "lift.csv"),
+    "dxf": ("profile.dxf", "profile_poly.dxf"),
+    "stl": ("cam.stl",),
+    "gcode": ("cam.ngc",),
+    "report": ("report.html",),
+}
+"""What ``build --only`` selects; ``summary.json`` is always written."""
+
+MOTION_TABLE_STEP_DEG = 0.1
+
+
+def load(path: str | Path) -> Project:
+    """Read and validate a design file; ``camcad.load(path).analyse()`` runs it."""
+    return Project(design=load_design(path))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Analysis:
+    """Everything camcad computes for a design, before any file is written.
+
+    Attributes
+    ----------
+    motion
+        s, v, a, j over ``geometry.phi`` (0.1° grid plus breakpoints).
+    geometry
+        Pitch curve, profile, pressure angle, curvature, undercut.
+    dynamics
+        Contact force, torque, Hertz stress (over the same angles).
+    fit
+        The certified NURBS of the profile, or None when not requested.
+    toolpath
+        The planned G-code toolpath, or None when not requested.
+    timings
+        Seconds per stage.
+    """
+
+    design: Design
+    cam: Cam
+    motion: Motion
+    geometry: GeometryAnalysis
+    dynamics: DynamicsResult
+    fit: ProfileFit | None
+    toolpath: Any
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def warnings(self) -> list[str]:
+        """Every non-fatal finding of every stage."""
+        out = list(self.geometry.warnings)
+        out += list(self.dynamics.summary().get("warnings", []))
+        return out
+
+    @property
+    def violations(self) -> list[str]:
+        """Design limits that are broken (``camcad check`` exits 3 when any)."""
+        out = []
+        if self.geometry.undercut is not None:
+            out.append("undercut")
+        if any(w.startswith("pressure angle") for w in self.geometry.warnings):
+            out.append("pressure angle")
+        dyn = self.dynamics.summary()
+        if dyn.get("jump"):
+            out.append("jump")
+        if dyn.get("hertz_stress_max_MPa") is not None and self.design.dynamics.allowable_stress is not None:
+            if dyn["hertz_stress_max_MPa"] > self.design.dynamics.allowable_stress:
+                out.append("contact stress")
+        return out
+
+    def summary(self) -> dict[str, Any]:
+        """The content of ``summary.json``."""
+        out: dict[str, Any] = {
+            "camcad_version": __version__,
+            "design": {"name": self.design.cam.name, "source": self.design.source},
+            "motion": motion_summary(self.cam, self.motion),
+            "geometry": self.geometry.summary(),
+            "dynamics": self.dynamics.summary(),
+        }
+        if self.fit is not None:
+            out["fit"] = self.fit.summary()
+        if self.toolpath is not None:
+            out["gcode"] = self.toolpath.summary()
+        out["warnings"] = self.warnings
+        out["violations"] = self.violations
+        return out
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BuildResult:
+    """What :func:`build` wrote: the analysis, the output folder and the files."""
+
+    analysis: Analysis
+    outdir: Path
+    files: tuple[Path, ...]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Project:
+    """A loaded design with the Python API of ``camcad.load``."""
+
+    design: Design
+
+    def analyse(self, *, fit: bool = True, toolpath: bool = True) -> Analysis:
+        """Run every analysis stage; see :func:`analyse`."""
+        return analyse(self.design, fit=fit, toolpath=toolpath)
+
+    def build(self, outdir: str | Path, *, only: Iterable[str] | None = None) -> BuildResult:
+        """Write the shop files into ``outdir``; see :func:`build`."""
+        return build(self.design, outdir, only=only)
+
+
+def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
+    """Peaks of |v|, |a|, |j| with their angles, the lift and the joint report."""
+    out: dict[str, Any] = {"lift_mm": cam.program.lift}
+    for key, unit, values in (
+        ("v", "mm_per_rad", motion.v),
+        ("a", "mm_per_rad2", motion.a),
+        ("j", "mm_per_rad3", motion.j),
+    ):
+        i = int(np.argmax(np.abs(values)))
+        out[f"{key}_max_abs_{unit}"] = float(abs(values[i]))
+        out[f"{key}_max_abs_angle_deg"] = math.degrees(float(motion.phi[i]))
+    out["joints"] = [
+        {
+            "angle_deg": math.degrees(j.phi),
+            "segment": j.index,
+            "dv_mm_per_rad": j.dv,
+            "da_mm_per_rad2": j.da,
+            "dj_mm_per_rad3": j.dj,
+            "continuity": j.continuity,
+            "text": j.describe(),
+        }
+        for j in cam.program.joints()
+    ]
+    return out
+
+
+def _timed(timings: dict[str, float], progress: Progress | None, name: str, fn: Callable[[], Any]) -> Any:
+    start = time.perf_counter()
+    result = fn()
+    timings[name] = time.perf_counter() - start
+    if progress is not None:
+        progress(name, timings[name])
+    return result
+
+
+def analyse(
+    design: Design,
+    *,
+    fit: bool = True,
+    toolpath: bool = True,
+    strict: bool = True,
+    progress: Progress | None = None,
+) -> Analysis:
+    """Run motion → geometry → dynamics → fit → toolpath plan.
+
+    Parameters
+    ----------
+    design
+        A validated design.
+    fit, toolpath
+        Whether to run the NURBS fit and plan the G-code toolpath.
+    strict
+        Raise on hard limits (undercut; gouge from the toolpath plan). With
+        ``strict=False`` an undercut is only recorded (``camcad check``).
+    progress
+        Called after each stage with its name and duration.
+
+    Raises
+    ------
+    UndercutError, GougeError, FitError
+        When ``strict`` and the design breaks a hard limit.
+    """
+    timings: dict[str, float] = {}
+    cam = Cam.from_design(design)
+    geometry = _timed(
+        timings,
+        progress,
+        "geometry",
+        lambda: analyse_geometry(
+            cam, max_pressure_angle=design.cam.max_pressure_angle, face_width=design.follower.face_width
+        ),
+    )
+    motion = cam.motion(geometry.phi)
+    if geometry.undercut is not None and strict:
+        raise undercut_error(geometry, min_curvature_radius=design.min_curvature_radius)
+    dynamics = _timed(
+        timings,
+        progress,
+        "dynamics",
+        lambda: analyse_dynamics(
+            motion, pressure_angle=geometry.pressure_angle, profile_rho=geometry.profile.rho, design=design
+        ),
+    )
+    fitted = None
+    if fit and geometry.undercut is None:
+        fitted = _timed(
+            timings,
+            progress,
+            "fit",
+            lambda: fit_profile(
+                geometry.phi,
+                np.asarray(geometry.profile.point),
+                exact=lambda phi: cam.profile(phi).point,
+                breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
+                tolerance=design.fit.tolerance,
+                max_control_points=design.fit.max_control_points,
+            ),
+        )
+    planned = None
+    if toolpath and geometry.undercut is None:
+        from camcad.export.gcode import plan_toolpath
+
+        planned = _timed(
+            timings,
+            progress,
+            "toolpath",
+            lambda: plan_toolpath(
+                cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
+            ),
+        )
+    return Analysis(
+        design=design,
+        cam=cam,
+        motion=motion,
+        geometry=geometry,
+        dynamics=dynamics,
+        fit=fitted,
+        toolpath=planned,
+        timings=timings,
+    )
+
+
+def _groups(only: Iterable[str] | None) -> set[str]:
+    if only is None:
+        return set(OUTPUT_GROUPS)
+    chosen = {g.strip().lower() for g in only if g.strip()}
+    aliases = {"mesh": "stl", "ngc": "gcode", "csv": "tables", "html": "report"}
+    chosen = {aliases.get(g, g) for g in chosen}
+    unknown = sorted(chosen - set(OUTPUT_GROUPS))
+    if unknown:
+        raise DesignError("--only", f"unknown output {unknown[0]!r} (allowed: {', '.join(OUTPUT_GROUPS)})")
+    return chosen
+
+
+def _prepare_outdir(outdir: Path) -> Path:
+    """Check that ``outdir`` can be created or written; return a temporary sibling folder."""
+    if outdir.exists() and not outdir.is_dir():
+        raise DesignError("--output", f"{outdir} exists and is not a folder")
+    parent = outdir.parent if outdir.parent != Path("") else Path(".")
+    probe = parent
+    while not probe.exists():
+        probe = probe.parent
+    if not probe.is_dir() or not os.access(probe, os.W_OK):
+        raise DesignError("--output", f"cannot create {outdir}: {probe} is not a writable folder")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        return Path(tempfile.mkdtemp(prefix=f".{outdir.name}.camcad-", dir=parent))
+    except OSError as err:
+        raise DesignError("--output", f"cannot write to {parent}: {err.strerror or err}") from None
+
+
+def build(
+    design: Design,
+    outdir: str | Path,
+    *,
+    only: Iterable[str] | None = None,
+    progress: Progress | None = None,
+) -> BuildResult:
+    """Analyse the design and write its files into ``outdir`` all at once.
+
+    Everything is written into a temporary folder beside ``outdir`` first; the
+    files are moved into ``outdir`` only when every stage has succeeded, so a
+    failed build leaves ``outdir`` exactly as it was.
+    """
+    groups = _groups(only)
+    outdir = Path(outdir)
+    tmp = _prepare_outdir(outdir)
+    try:
+        analysis = analyse(design, fit=True, toolpath="gcode" in groups, progress=progress)
+        written = _write_outputs(analysis, tmp, groups=groups, progress=progress)
+        written.append(write_json(tmp / "summary.json", analysis.summary()))
+        final = _commit(tmp, outdir, [Path(p).name for p in written])
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return BuildResult(analysis=analysis, outdir=outdir, files=tuple(final))
+
+
+def _write_outputs(
+    analysis: Analysis, folder: Path, *, groups: set[str], progress: Progress | None
+) -> list[Path]:
+    """Write the selected output groups into ``folder``; return the paths written."""
+    design, cam, timings = analysis.design, analysis.cam, analysis.timings
+    written: list[Path] = []
+
+    def stage(name: str, fn: Callable[[], Any]) -> None:
+        result = _timed(timings, progress, name, fn)
+        written.extend(result if isinstance(result, list) else [result])
+
+    if "tables" in groups:
+        stage("tables", lambda: write_tables(analysis, folder))
+    if "dxf" in groups:
+        from camcad.export.dxf import write_profile_dxf, write_profile_poly_dxf
+
+        stage(
+            "dxf",
+            lambda: [
+                write_profile_dxf(folder / "profile.dxf", cam=cam, fit=analysis.fit, design=design),
+                write_profile_poly_dxf(folder / "profile_poly.dxf", cam=cam, fit=analysis.fit, design=design),
+            ],
+        )
+    if "stl" in groups:
+        from camcad.export.mesh import build_solid, write_meshes
+
+        stage(
+            "mesh",
+            lambda: write_meshes(folder, build_solid(analysis.fit, design, cam=cam), design.mesh.formats),
+        )
+    if "gcode" in groups:
+        from camcad.export.gcode import render_gcode
+
+        stage(
+            "gcode",
+            lambda: write_text(folder / "cam.ngc", render_gcode(analysis.toolpath, design.gcode.dialect)),
+        )
+    if "report" in groups:
+        from camcad.report import write_report
+
+        stage("report", lambda: write_report(analysis, folder / "report.html"))
+    return written
+
+
+def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
+    """motion.csv, profile.csv, dynamics.csv, points.csv and lift.csv into ``folder``."""
+    from camcad.export.tables import write_lift_csv, write_points_csv
+
+    cam, geo, design = analysis.cam, analysis.geometry, analysis.design
+    step = math.radians(MOTION_TABLE_STEP_DEG)
+    grid = np.arange(round(2 * math.pi / step)) * step
+    m = cam.motion(grid)
+    motion_csv = write_csv(
+        folder / "motion.csv",
+        {
+            "angle_deg": np.degrees(grid),
+            "s_mm": m.s,
+            "v_mm_per_rad": m.v,
+            "a_mm_per_rad2": m.a,
+            "j_mm_per_rad3": m.j,
+        },
+    )
+    profile_csv = write_csv(
+        folder / "profile.csv",
+        {
+            "angle_deg": np.degrees(geo.phi),
+            "pitch_x": geo.pitch.point[:, 0],
+            "pitch_y": geo.pitch.point[:, 1],
+            "x": geo.profile.point[:, 0],
+            "y": geo.profile.point[:, 1],
+            "nx": geo.profile.normal[:, 0],
+            "ny": geo.profile.normal[:, 1],
+            "pressure_angle_deg": np.degrees(geo.pressure_angle),
+            "rho_pitch_mm": geo.pitch.rho,
+            "rho_profile_mm": geo.profile.rho,
+        },
+    )
+    dyn = analysis.dynamics
+    dynamics_csv = write_csv(
+        folder / "dynamics.csv",
+        {
+            "angle_deg": np.degrees(dyn.phi),
+            "contact_force_N": dyn.contact_force,
+            "torque_Nmm": dyn.torque,
+            "hertz_stress_MPa": dyn.hertz_stress,
+        },
+    )
+    return [
+        motion_csv,
+        profile_csv,
+        dynamics_csv,
+        write_points_csv(folder / "points.csv", cam, design),
+        write_lift_csv(folder / "lift.csv", cam, design),
+    ]
+
+
+def _commit(tmp: Path, outdir: Path, names: list[str]) -> list[Path]:
+    """Move the finished files into ``outdir`` (each move an atomic rename)."""
+    outdir.mkdir(parents=True, exist_ok=True)
+    final = []
+    for name in names:
+        os.replace(tmp / name, outdir / name)
+        final.append(outdir / name)
+    return final
