@@ -26,7 +26,7 @@ from matplotlib.patches import Circle, FancyArrowPatch, Polygon
 from camcad._typing import FloatArray
 
 if TYPE_CHECKING:
-    from camcad.pipeline import Analysis
+    from camcad.analysis import Analysis
 
 __all__ = [
     "CURVATURE_CLIP",

@@ -1,6 +1,6 @@
 """Self-contained HTML reports of one design, or several side by side.
 
-:func:`render_report` turns an :class:`~camcad.pipeline.Analysis` into one
+:func:`render_report` turns an :class:`~camcad.analysis.Analysis` into one
 HTML page that opens offline: warnings first, the key numbers at a glance,
 the figures (PNG, embedded as base64 ``data:`` URIs) and the full tables of
 ``summary.json``. :func:`render_compare` overlays several designs and tabulates
@@ -28,7 +28,7 @@ from camcad._plots import Plot, compare_plots, report_plots
 from camcad.export.records import write_text
 
 if TYPE_CHECKING:
-    from camcad.pipeline import Analysis
+    from camcad.analysis import Analysis
 
 __all__ = [
     "compare_table",

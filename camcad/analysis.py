@@ -1,0 +1,119 @@
+"""The results of analysing a design: one value object the report and the files are made from.
+
+:class:`Analysis` gathers what every stage computed (motion, geometry,
+dynamics, fit, toolpath) with the summary that goes to ``summary.json``. It
+sits below the report and the pipeline: both read it, neither is imported here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from camcad._version import __version__
+from camcad.design import Design
+from camcad.dynamics import DynamicsResult
+from camcad.fit import ProfileFit
+from camcad.geometry import Cam, GeometryAnalysis
+from camcad.motion.program import Motion
+
+__all__ = ["Analysis", "motion_summary"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Analysis:
+    """Everything camcad computes for a design, before any file is written.
+
+    Attributes
+    ----------
+    motion
+        s, v, a, j over ``geometry.phi`` (0.1° grid plus breakpoints).
+    geometry
+        Pitch curve, profile, pressure angle, curvature, undercut.
+    dynamics
+        Contact force, torque, Hertz stress (over the same angles).
+    fit
+        The certified NURBS of the profile, or None when not requested.
+    toolpath
+        The planned G-code toolpath, or None when not requested.
+    timings
+        Seconds per stage.
+    """
+
+    design: Design
+    cam: Cam
+    motion: Motion
+    geometry: GeometryAnalysis
+    dynamics: DynamicsResult
+    fit: ProfileFit | None
+    toolpath: Any
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def warnings(self) -> list[str]:
+        """Every non-fatal finding of every stage."""
+        out = list(self.geometry.warnings)
+        out += list(self.dynamics.summary().get("warnings", []))
+        return out
+
+    @property
+    def violations(self) -> list[str]:
+        """Design limits that are broken (``camcad check`` exits 3 when any)."""
+        out = []
+        if self.geometry.undercut is not None:
+            out.append("undercut")
+        if any(w.startswith("pressure angle") for w in self.geometry.warnings):
+            out.append("pressure angle")
+        dyn = self.dynamics.summary()
+        if dyn.get("jump"):
+            out.append("jump")
+        if dyn.get("hertz_stress_max_MPa") is not None and self.design.dynamics.allowable_stress is not None:
+            if dyn["hertz_stress_max_MPa"] > self.design.dynamics.allowable_stress:
+                out.append("contact stress")
+        return out
+
+    def summary(self) -> dict[str, Any]:
+        """The content of ``summary.json``."""
+        out: dict[str, Any] = {
+            "camcad_version": __version__,
+            "design": {"name": self.design.cam.name, "source": self.design.source},
+            "motion": motion_summary(self.cam, self.motion),
+            "geometry": self.geometry.summary(),
+            "dynamics": self.dynamics.summary(),
+        }
+        if self.fit is not None:
+            out["fit"] = self.fit.summary()
+        if self.toolpath is not None:
+            out["gcode"] = self.toolpath.summary()
+        out["warnings"] = self.warnings
+        out["violations"] = self.violations
+        return out
+
+
+def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
+    """Peaks of |v|, |a|, |j| with their angles, the lift and the joint report."""
+    out: dict[str, Any] = {"lift_mm": cam.program.lift}
+    for key, unit, values in (
+        ("v", "mm_per_rad", motion.v),
+        ("a", "mm_per_rad2", motion.a),
+        ("j", "mm_per_rad3", motion.j),
+    ):
+        i = int(np.argmax(np.abs(values)))
+        out[f"{key}_max_abs_{unit}"] = float(abs(values[i]))
+        out[f"{key}_max_abs_angle_deg"] = math.degrees(float(motion.phi[i]))
+    out["joints"] = [
+        {
+            "angle_deg": math.degrees(j.phi),
+            "segment": j.index,
+            "dv_mm_per_rad": j.dv,
+            "da_mm_per_rad2": j.da,
+            "dj_mm_per_rad3": j.dj,
+            "continuity": j.continuity,
+            "text": j.describe(),
+        }
+        for j in cam.program.joints()
+    ]
+    return out
