@@ -25,7 +25,7 @@ from camcad.design import Design, load_design
 from camcad.dynamics import analyse_dynamics
 from camcad.errors import DesignError
 from camcad.export.records import write_csv, write_json, write_text
-from camcad.fit import fit_profile
+from camcad.fit import fit_cam_profile
 from camcad.geometry import Cam, analyse_geometry, undercut_error
 
 __all__ = [
@@ -147,13 +147,8 @@ def analyse(
             timings,
             progress,
             "fit",
-            lambda: fit_profile(
-                geometry.phi,
-                np.asarray(geometry.profile.point),
-                exact=lambda phi: cam.profile(phi).point,
-                breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
-                tolerance=design.fit.tolerance,
-                max_control_points=design.fit.max_control_points,
+            lambda: fit_cam_profile(
+                cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
             ),
         )
     planned = None

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 from camcad.fit._profile import ProfileFit, fit_points, fit_profile
 from camcad.fit.bspline import clamped_from_periodic, to_geomdl
+from camcad.fit.cam import fit_cam_profile
 from camcad.fit.curve import BSplineCurve
 
 __all__ = [
     "BSplineCurve",
     "ProfileFit",
     "clamped_from_periodic",
+    "fit_cam_profile",
     "fit_points",
     "fit_profile",
     "to_geomdl",

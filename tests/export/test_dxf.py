@@ -22,7 +22,7 @@ from camcad.export.dxf import (
     write_profile_dxf,
     write_profile_poly_dxf,
 )
-from camcad.fit import ProfileFit, fit_profile
+from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.geometry.cam import Cam
 from tests.conftest import make_design
 
@@ -39,16 +39,9 @@ DESIGNS = {
 def cam_and_fit(design: Design) -> tuple[Cam, ProfileFit]:
     """The exact cam and its certified fit, as the pipeline makes them."""
     cam = Cam.from_design(design)
-    phi = cam.sample_phi()
-    fit = fit_profile(
-        phi,
-        np.asarray(cam.profile(phi).point),
-        exact=lambda p: cam.profile(p).point,
-        breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
-        tolerance=design.fit.tolerance,
-        max_control_points=design.fit.max_control_points,
+    return cam, fit_cam_profile(
+        cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
     )
-    return cam, fit
 
 
 def distance_to_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:

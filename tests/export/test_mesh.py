@@ -30,7 +30,7 @@ from camcad.export._contours import (
 )
 from camcad.export.atomic import atomic_write, atomic_write_text
 from camcad.export.mesh import MESH_FORMATS, SolidResult, build_solid, write_meshes
-from camcad.fit import ProfileFit, fit_profile
+from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.fit.bspline import clamped_from_periodic
 from camcad.fit.curve import BSplineCurve
 from camcad.geometry.cam import Cam
@@ -42,16 +42,9 @@ KEYED = {"cam": {"bore": 12.0, "keyway_width": 4.0, "keyway_depth": 2.0}}
 def cam_and_fit(design: Design) -> tuple[Cam, ProfileFit]:
     """The exact cam and its certified fit, as the pipeline makes them."""
     cam = Cam.from_design(design)
-    phi = cam.sample_phi()
-    fit = fit_profile(
-        phi,
-        np.asarray(cam.profile(phi).point),
-        exact=lambda p: cam.profile(p).point,
-        breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
-        tolerance=design.fit.tolerance,
-        max_control_points=design.fit.max_control_points,
+    return cam, fit_cam_profile(
+        cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
     )
-    return cam, fit
 
 
 @pytest.fixture(scope="module")

@@ -13,13 +13,12 @@ import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from camcad.design import Design, load_design
 from camcad.export.dxf import write_profile_dxf, write_profile_poly_dxf
 from camcad.export.mesh import SolidResult, build_solid, write_meshes
-from camcad.fit import ProfileFit, fit_profile
+from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.geometry.cam import Cam
 from tests.conftest import SAMPLES, make_design
 
@@ -49,14 +48,8 @@ class Built:
 
 
 def _fit(design: Design, cam: Cam) -> ProfileFit:
-    phi = cam.sample_phi()
-    return fit_profile(
-        phi,
-        np.asarray(cam.profile(phi).point),
-        exact=lambda p: cam.profile(p).point,
-        breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
-        tolerance=design.fit.tolerance,
-        max_control_points=design.fit.max_control_points,
+    return fit_cam_profile(
+        cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
     )
 
 
