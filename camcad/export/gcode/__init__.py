@@ -26,7 +26,8 @@ True
 '(camcad G-code: demo)'
 """
 
-from camcad.export.gcode.biarc import Pieces, biarc_pieces, fit_curve, measure_deviation
+from camcad.export.gcode.arcspline import fit_curve
+from camcad.export.gcode.biarc import Pieces, biarc_pieces, measure_deviation
 from camcad.export.gcode.dialects import DIALECTS, DialectRules, dialect_rules
 from camcad.export.gcode.moves import Move, MoveKind
 from camcad.export.gcode.parse import GcodeSyntaxError, parse_canon, parse_gcode

@@ -16,7 +16,8 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.errors import DesignLimitError
-from camcad.export.gcode.biarc import CurveFn, Pieces, fit_curve, measure_deviation
+from camcad.export.gcode.arcspline import fit_curve
+from camcad.export.gcode.biarc import CurveFn, Pieces, measure_deviation
 from camcad.export.gcode.moves import MoveKind
 from camcad.geometry.cam import Cam
 

@@ -1,14 +1,16 @@
-"""Tangent-continuous biarcs fitted to an exact curve within a measured tolerance.
+"""Biarcs and the machinery to measure arc paths against an exact curve.
 
 The curve is any smooth plane curve C(φ) given with its first two
-φ-derivatives (for camcad: ``cam.offset(phi, tool_radius)``). Each φ-interval
-is replaced by two circular arcs that meet the curve's end points and end
-tangents and join each other tangentially; intervals are split until the
-two-way distance between the arcs and the curve, measured on samples of both,
-is within the tolerance.
+φ-derivatives (for camcad: ``cam.offset(phi, tool_radius)``). A biarc
+replaces a φ-interval by two circular arcs that meet the curve's end points
+and end tangents and join each other tangentially; :func:`measure_deviation`
+gives the two-way distance between pieces and the curve, measured on samples
+of both. The arc-spline fit in :mod:`camcad.export.gcode.arcspline` builds on
+these.
 
 Pieces are held in :class:`Pieces`, a set of arrays of shape (n, 2, ...): two
-pieces (arcs or lines) per φ-interval. A piece runs from ``start`` to ``end``
+pieces (arcs or lines) per φ-interval, the second empty where one arc
+suffices. A piece runs from ``start`` to ``end``
 about ``center``; its radius may change linearly from ``r_start`` to ``r_end``
 (a controller interpolates a slightly inconsistent arc as a spiral, and
 rounded output is measured that way).
@@ -29,7 +31,6 @@ __all__ = [
     "Pieces",
     "biarc_pieces",
     "chord_pieces",
-    "fit_curve",
     "measure_deviation",
     "sample_pieces",
 ]
@@ -391,54 +392,11 @@ def concat_pieces(parts: Sequence[Pieces]) -> Pieces:
     return Pieces(**{f: v[order] for f, v in joined.items()})
 
 
-def fit_curve(
-    curve: CurveFn,
-    breaks: Sequence[float] | FloatArray,
-    tolerance: float,
-    *,
-    arcs: bool = True,
+def _biarc_march(
+    curve: CurveFn, edges: FloatArray, tolerance: float, arcs: bool
 ) -> tuple[Pieces, FloatArray]:
-    """Fit biarcs (or chords) to C(φ) between sorted φ-breaks within a tolerance.
-
-    Parameters
-    ----------
-    curve
-        The exact curve C(φ) with its derivatives; tangents C′/|C′| must be
-        continuous inside each break interval.
-    breaks
-        (k + 1,) strictly increasing φ [rad]: points every fit must pass
-        through (motion breakpoints, the start angle, tab edges).
-    tolerance
-        Two-way deviation allowed for each interval [mm].
-    arcs
-        True for biarcs, False for straight chords (the G1-only comparison).
-
-    Returns
-    -------
-    (Pieces, FloatArray)
-        The accepted pieces in φ order and their measured deviations (n,) [mm].
-
-    Raises
-    ------
-    ValueError
-        When an interval shorter than 1e-9 rad still misses the tolerance
-        (a corner or cusp of the curve).
-
-    Notes
-    -----
-    A greedy march, run for all break intervals at once. From the current
-    node it measures (:func:`measure_deviation`) the fits ending on the curve
-    at a geometric ladder of candidate angles and keeps the farthest that
-    passes; it then tries to reach up to 1.8 times as far with the end node
-    moved inside the tolerance band (by up to ±0.4 tol along the normal, its
-    tangent turned by up to ±2 tol/chord) and the joint moved (d₁/d of 0.75
-    or 1.33), and keeps the farthest passing fit (a small use of the
-    freedom that arc-spline methods such as Meek & Walton 1992 exploit fully).
-    Nodes at the breaks stay on the curve. Every accepted interval has been
-    measured, so the tolerance does not rest on an error estimate.
-    """
+    """Greedy march of biarcs (or chords) with end nodes on or near the curve."""
     builder: Builder = biarc_pieces if arcs else chord_pieces
-    edges = np.asarray(breaks, dtype=float)
     cur, stop = edges[:-1].copy(), edges[1:].copy()
     cur_p, cur_t = _node(curve, cur)
     scale = np.ones_like(cur)
