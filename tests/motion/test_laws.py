@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from camcad.errors import DesignError
+from camcad.motion._scca import _scca_evaluate
 from camcad.motion.laws import (
     DUDLEY_MAX_DEGREE,
     LAWS,
@@ -25,7 +26,6 @@ from camcad.motion.laws import (
     Poly345,
     Poly4567,
     Vap,
-    _scca_evaluate,
     dudley_coefficients,
     dudley_matrix,
     make_law,
