@@ -19,6 +19,7 @@ from tests.conftest import ROOT
 
 HARMONIC = (ROOT / "samples" / "quintero_harmonic.toml").read_text()
 VAP = (ROOT / "samples" / "quintero_vap_b01.toml").read_text()
+HREN = (ROOT / "samples" / "hren_tappet.toml").read_text()
 
 
 def edit(text: str, pattern: str, replacement: str, count: int = 1) -> str:
@@ -58,6 +59,10 @@ BROKEN = {
         3,
         "undercut",
     ),
+    "b_equals_1": (edit(VAP, r"^b = 0.1", "b = 1.0"), 2, "motion[0].b"),
+    "even_degree": (edit(HREN, r"^degree = 9", "degree = 8"), 2, "motion[0].degree"),
+    "misspelt_key": (edit(HARMONIC, r"^roller_radius", "roler_radius"), 2, "did you mean 'roller_radius'"),
+    "negative_lift": (edit(HARMONIC, r"^lift = 30.0", "lift = -30.0"), 2, "motion[0].lift"),
     "gouge": (edit(VAP, r"^tool_diameter = .*$", "tool_diameter = 130.0"), 3, "gouge"),
 }
 
