@@ -4,7 +4,9 @@ The profile is fitted by a periodic cubic B-spline by least squares over
 chord-length parameters (Quang & Hung 2015, eqs. 6–10), with knots at the
 motion breakpoints and the fewest control points whose certified distance to
 the exact profile is below the tolerance. The periodic curve converts exactly
-to a clamped closed curve and to a ``geomdl`` curve for export.
+to a clamped closed curve, opened inside the longest stretch between motion
+breakpoints so its seam adds no tangent or curvature jump, and to a ``geomdl``
+curve for export.
 """
 
 from __future__ import annotations

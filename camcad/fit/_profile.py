@@ -5,7 +5,7 @@ smallest number of control points whose certified error (true distance from
 the samples, and from exact profile points between them, to the curve) is
 below the tolerance:
 
-1. fixed knots: the seam and the motion breakpoints (multiplicity p − k);
+1. fixed knots: u = 0 and the motion breakpoints (multiplicity p − k);
 2. for a count of free knots: place them (:mod:`camcad.fit.knots`), fit by
    least squares over chord-length parameters (Quang & Hung 2015, eq. 10),
    move the parameters one step towards the foot points and refit
@@ -57,6 +57,7 @@ from camcad.fit.knots import (
     fixed_knots,
     place_knots,
 )
+from camcad.fit.seam import longest_stretch, seam_parameter
 
 __all__ = ["ProfileFit", "fit_points", "fit_profile"]
 
@@ -77,13 +78,17 @@ class ProfileFit:
         Periodic curve (closed input) or clamped open curve (open input);
         parameter domain [0, 1] in normalised chord length.
     clamped
-        Clamped export form of the same curve; for closed input
-        ``control_points[-1] == control_points[0]``.
+        Clamped export form of the same curve. For closed input it opens at
+        ``seam`` and its domain is [0, 1] again: ``clamped.evaluate(v)``
+        equals ``curve.evaluate(v + seam)``; and
+        ``control_points[-1] == control_points[0]``. For open input it is
+        ``curve``.
     params
-        (n,) increasing foot-point parameter of each input sample: the curve
-        point nearest the sample is ``curve.evaluate(params)``. For closed
-        input the first may lie a hair below 0 (its foot point precedes the
-        seam); ``curve`` wraps it, for ``clamped`` use ``np.mod(params, 1)``.
+        (n,) increasing foot-point parameter of each input sample on
+        ``curve``: the curve point nearest the sample is
+        ``curve.evaluate(params)``. For closed input the first may lie a hair
+        below 0 (its foot point precedes u = 0); ``curve`` wraps it. On
+        ``clamped`` use :attr:`clamped_params`.
     tolerance
         Requested tolerance [mm].
     max_error
@@ -100,6 +105,11 @@ class ProfileFit:
         form [rad] (0 for open input).
     seam_curvature_jump
         |Δκ| across the seam of the clamped form [1/mm] (0 for open input).
+    seam
+        Parameter u_s of ``curve`` where ``clamped`` starts: inside the
+        longest stretch between motion breakpoints (:mod:`camcad.fit.seam`),
+        so the seam adds no tangent or curvature jump and the exported spline
+        does not start at a joint; 0 without breakpoints and for open input.
     """
 
     curve: BSplineCurve
@@ -112,6 +122,22 @@ class ProfileFit:
     degree: int
     seam_tangent_jump: float
     seam_curvature_jump: float
+    seam: float = 0.0
+
+    @property
+    def clamped_params(self) -> FloatArray:
+        """(n,) ``params`` on ``clamped``: ``np.mod(params − seam, 1)``.
+
+        ``clamped.evaluate(clamped_params)`` equals ``curve.evaluate(params)``;
+        for closed input they increase from the first sample past the seam
+        and drop by one period once.
+        """
+        if self.curve.periodic:
+            out = np.mod(np.asarray(self.params) - self.seam, 1.0)
+        else:
+            out = np.array(self.params)
+        readonly(out)
+        return out
 
     def summary(self) -> dict[str, float | int]:
         """Tolerance, errors [mm], control points and degree for the report."""
@@ -135,16 +161,22 @@ class _Problem:
     degree: int
     tolerance: float
     max_control_points: int
+    seam_window: tuple[float, float] | None = None  # u of the middle half of the longest stretch
 
     @property
     def periodic(self) -> bool:
         return self.fixed.periodic
 
     def control_points(self, n_free: int) -> int:
-        """Control points of the clamped form for ``n_free`` free knots."""
+        """Control points of the clamped form for ``n_free`` free knots (at most).
+
+        A closed curve opened at a knot of multiplicity μ has
+        (knots per period) + p + 1 − μ; inside the longest stretch μ = 1 if a
+        free knot lies near its middle, else 0, which is what is counted.
+        """
         p = self.degree
         if self.periodic:
-            seam = int(self.fixed.multiplicity[0])
+            seam = int(self.fixed.multiplicity[0]) if self.seam_window is None else 0
             return self.fixed.n_fixed + n_free - seam + p + 1
         return self.fixed.n_fixed + n_free + p + 1
 
@@ -372,8 +404,9 @@ def _search(problem: _Problem) -> tuple[BSplineCurve, tuple[Certificate, Certifi
 def _result(
     problem: _Problem, curve: BSplineCurve, certs: tuple[Certificate, Certificate | None]
 ) -> ProfileFit:
-    clamped = clamped_from_periodic(curve)
     at_samples, _ = certs
+    seam = None if problem.seam_window is None else seam_parameter(curve, *problem.seam_window)
+    clamped = clamped_from_periodic(curve, seam=seam)
     params = at_samples.foot
     if problem.periodic:
         tangent_jump, curvature_jump = seam_jumps(clamped)
@@ -390,6 +423,7 @@ def _result(
         degree=problem.degree,
         seam_tangent_jump=tangent_jump,
         seam_curvature_jump=curvature_jump,
+        seam=0.0 if seam is None else seam,
     )
 
 
@@ -450,8 +484,9 @@ def fit_profile(
     Returns
     -------
     ProfileFit
-        The periodic curve (C^{p−1} at the seam by construction), its exact
-        clamped form, and the certificate.
+        The periodic curve (C^{p−1} at u = 0 by construction), its exact
+        clamped form opened inside the longest stretch between breakpoints
+        (:mod:`camcad.fit.seam`), and the certificate.
 
     Raises
     ------
@@ -489,11 +524,19 @@ def fit_profile(
     params = chord_length_params(pts, closed=True)
     phi_ext = np.append(ang, ang[0] + TWO_PI)
     t_ext = np.append(params, 1.0)
-    breaks = []
+
+    def u_of(angle: float) -> float:  # chord-length parameter of a cam angle, unwrapped
+        turns, rest = divmod(angle - ang[0], TWO_PI)
+        return turns + float(np.interp(ang[0] + rest, phi_ext, t_ext))
+
+    pairs = []
     for bp in breakpoints:
         phi_k, k = (bp.phi, bp.continuity) if hasattr(bp, "phi") else bp  # type: ignore[union-attr]
-        wrapped = ang[0] + np.mod(float(phi_k) - ang[0], TWO_PI)
-        breaks.append((float(np.interp(wrapped, phi_ext, t_ext)), int(k)))
+        pairs.append((float(phi_k), int(k)))
+    breaks = [(u_of(phi_k) % 1.0, k) for phi_k, k in pairs]
+    stretch = longest_stretch([phi_k for phi_k, _ in pairs])
+    lo, hi = stretch or (0.0, 0.0)
+    quarter = 0.25 * (hi - lo)  # the seam opens in the stretch's middle half (camcad.fit.seam)
     phi_mid = np.mod(0.5 * (phi_ext[1:] + phi_ext[:-1]), TWO_PI)
     between = np.asarray(exact(phi_mid), dtype=float)
     if between.shape != pts.shape:
@@ -506,6 +549,7 @@ def fit_profile(
         degree=degree,
         tolerance=tolerance,
         max_control_points=max_control_points,
+        seam_window=None if stretch is None else (u_of(lo + quarter), u_of(hi - quarter)),
     )
     return _result(problem, *_search(problem))
 

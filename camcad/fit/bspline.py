@@ -493,41 +493,69 @@ def insert_knot(
     return uq, qw
 
 
-def clamped_from_periodic(curve: BSplineCurve) -> BSplineCurve:
-    """Exact clamped form of a periodic curve, opened at the seam ``u = knots[p]``.
+def _snap(knots: FloatArray, u: float, period: float) -> float:
+    """``u``, or the knot within a rounding error (1e-12 period) of it."""
+    near = knots[np.abs(knots - u) <= 1e-12 * period]
+    return float(near[0]) if near.size else u
+
+
+def clamped_from_periodic(curve: BSplineCurve, *, seam: float | None = None) -> BSplineCurve:
+    """Exact clamped closed form of a periodic curve, opened at parameter ``seam``.
 
     Parameters
     ----------
     curve
-        Periodic curve (``periodic=True``).
+        Periodic curve (``periodic=True``) on the domain ``[a, b]``; a clamped
+        curve is returned unchanged.
+    seam
+        Parameter u_s where the closed curve opens (wrapped into ``[a, b)``);
+        default ``a``. Open it where the curve is C² (inside a knot span, or at
+        a knot of multiplicity <= p − 2), or the seam shows the curve's own
+        tangent or curvature jump.
 
     Returns
     -------
     BSplineCurve
-        Clamped curve on the same domain whose last control point equals the
-        first; it evaluates to the same points (to rounding, ~1e-13 mm).
+        Clamped curve on the same domain ``[a, b]``, started at u_s: its
+        point at v is ``curve.evaluate(v + u_s − a)`` (to rounding, ~1e-13
+        mm), so both trace the same closed point set. End knots of
+        multiplicity p + 1, last control point equal to the first.
 
     Notes
     -----
-    The seam knot is raised to multiplicity p at both ends of the domain by
-    knot insertion (Piegl & Tiller 1997, Alg. A5.1); the control points
-    outside the domain are then dropped and the end knots clamped
+    The periodic knot vector and control points are extended by one more
+    period, so that ``[u_s, u_s + period]`` lies inside the valid domain.
+    Then u_s and u_s + period are raised to multiplicity p by knot insertion
+    (Piegl & Tiller 1997, Alg. A5.1); the control points outside
+    ``[u_s, u_s + period]`` are dropped and the end knots clamped
     (multiplicity p + 1, which does not change the curve on the domain).
+    Last, the knots are shifted by a − u_s: a CAD reader then sees the usual
+    knot vector from a (0 for a fit) whatever the seam, and ezdxf, which
+    shifts knots to start at 0 anyway, agrees with ``evaluate``.
     """
     if not curve.periodic:
         return curve
     p = curve.degree
     a, b = curve.domain
+    period = b - a
     knots = np.asarray(curve.knots, dtype=float)
     ctrl = np.asarray(curve.control_points, dtype=float)
-    for value in (a, b):
+    k = len(ctrl) - p  # distinct control points
+    # two periods: tau_{i+K} = tau_i + period for the knots beyond the curve's own vector
+    knots = np.concatenate((knots, knots[2 * p + 1 :] + period))
+    ctrl = ctrl[np.arange(2 * k + p) % k]
+    u0 = a if seam is None else _snap(knots, a + float(np.mod(seam - a, period)), period)
+    u0 = a if u0 >= b else u0
+    u1 = b if u0 == a else _snap(knots, u0 + period, period)
+    for value in (u0, u1):
         s = int(np.count_nonzero(knots == value))
         knots, ctrl = insert_knot(knots, ctrl, p, value, max(p - s, 0))
-    first_a = int(np.searchsorted(knots, a, side="left"))
-    first_b = int(np.searchsorted(knots, b, side="left"))
+    first_a = int(np.searchsorted(knots, u0, side="left"))
+    first_b = int(np.searchsorted(knots, u1, side="left"))
     cps = ctrl[first_a - 1 : first_b].copy()
-    cps[-1] = cps[0]  # closed: C(b) = C(a) exactly
-    new_knots = np.concatenate(([a], knots[first_a : first_b + p], [b]))
+    cps[-1] = cps[0]  # closed: C(u1) = C(u0) exactly
+    inner = knots[first_a + p : first_b] - (u0 - a)  # shift the domain to [a, b]
+    new_knots = np.concatenate((np.full(p + 1, a), inner, np.full(p + 1, b)))
     readonly(cps, new_knots)
     return BSplineCurve(degree=p, knots=new_knots, control_points=cps, periodic=False)
 
@@ -545,7 +573,9 @@ def to_geomdl(curve: BSplineCurve) -> GeomdlBSpline.Curve:
     -------
     geomdl.BSpline.Curve
         Degree, control points and knot vector normalised to [0, 1]:
-        geomdl parameter v maps to ours by u = a + v (b - a).
+        geomdl parameter v maps to ours by u = a + v (b - a), ``(a, b)``
+        the clamped form's domain. A periodic curve opens at its domain
+        start; pass ``ProfileFit.clamped`` to keep the fit's seam.
     """
     from geomdl import BSpline as GeomdlBSpline
 

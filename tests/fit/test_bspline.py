@@ -149,6 +149,46 @@ def test_clamped_form_is_the_same_closed_curve(degree, n_knots, double):
     assert len(clamped.control_points) == n_knots + p  # simple seam knot: K + p
 
 
+def seam_cases(curve):
+    """Seams inside a span, at a simple knot, at the last knot and at a double knot (if any)."""
+    p = curve.degree
+    tau = curve.knots[p : len(curve.control_points)]
+    values, counts = np.unique(tau, return_counts=True)
+    cases = {"in-span": 0.5 * (tau[1] + tau[2]), "simple-knot": values[counts == 1][1], "last-knot": tau[-1]}
+    if np.any(counts > 1):
+        cases["double-knot"] = values[counts > 1][0]
+    return cases
+
+
+@pytest.mark.parametrize(("degree", "n_knots", "double"), CASES, ids=IDS)
+def test_clamped_form_opened_anywhere_is_the_same_closed_curve(degree, n_knots, double):
+    periodic = random_periodic(np.random.default_rng(11), degree, n_knots, double=double)
+    p = degree
+    for name, seam in seam_cases(periodic).items():
+        clamped = clamped_from_periodic(periodic, seam=seam)
+        assert clamped.domain == (0.0, 1.0), name
+        assert np.all(clamped.knots[: p + 1] == 0.0), name
+        assert np.all(clamped.knots[-p - 1 :] == 1.0), name
+        assert np.all(np.diff(clamped.knots) >= 0.0), name
+        assert len(clamped.knots) == len(clamped.control_points) + p + 1, name
+        assert np.array_equal(clamped.control_points[0], clamped.control_points[-1]), name
+        v = np.linspace(0.0, 1.0, 2001)
+        assert_allclose(clamped.evaluate(v), periodic.evaluate(v + seam), atol=1e-9, err_msg=name)
+        mult = int(np.count_nonzero(periodic.knots[p : len(periodic.control_points)] == seam))
+        assert len(clamped.control_points) == n_knots + p + 1 - mult, name
+
+
+def test_clamped_form_wraps_the_seam_into_the_domain():
+    periodic = random_periodic(np.random.default_rng(4), 3, 9)
+    inside = clamped_from_periodic(periodic, seam=0.3)
+    for seam in (1.3, -0.7):
+        other = clamped_from_periodic(periodic, seam=seam)
+        assert_allclose(other.knots, inside.knots, atol=1e-15)
+        assert_allclose(other.control_points, inside.control_points, atol=1e-12)
+    at_one = clamped_from_periodic(periodic, seam=1.0)
+    assert np.array_equal(at_one.control_points, clamped_from_periodic(periodic).control_points)
+
+
 def test_clamped_form_of_a_clamped_curve_is_itself():
     knots = clamped_knot_vector(np.array([0.5]), 3)
     curve = BSplineCurve(degree=3, knots=knots, control_points=np.ones((5, 2)))
@@ -165,3 +205,15 @@ def test_geomdl_agrees(degree, n_knots, double):
     u = np.linspace(0.0, 1.0, 401)
     theirs = np.array(crv.evaluate_list(u.tolist()))
     assert_allclose(theirs, periodic.evaluate(u), atol=1e-9)
+
+
+@pytest.mark.parametrize(("degree", "n_knots", "double"), CASES, ids=IDS)
+def test_geomdl_agrees_with_a_clamped_form_opened_inside(degree, n_knots, double):
+    periodic = random_periodic(np.random.default_rng(5), degree, n_knots, double=double)
+    seam = 0.5 * (periodic.knots[degree + 1] + periodic.knots[degree + 2])
+    crv = to_geomdl(clamped_from_periodic(periodic, seam=seam))
+    assert crv.knotvector[: degree + 1] == [0.0] * (degree + 1)
+    assert crv.knotvector[-degree - 1 :] == [1.0] * (degree + 1)
+    v = np.linspace(0.0, 1.0, 401)
+    theirs = np.array(crv.evaluate_list(v.tolist()))
+    assert_allclose(theirs, periodic.evaluate(seam + v), atol=1e-9)

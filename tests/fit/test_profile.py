@@ -101,10 +101,10 @@ def cam(request):
 def test_circle_radius_error_below_tolerance_everywhere():
     fit = fit_profile(PHI, circle(PHI), exact=circle, tolerance=TOL)
     assert fit.max_error <= TOL
-    u = np.linspace(0.0, 1.0, 200_001)
     for curve in (fit.curve, fit.clamped):
-        radius = np.hypot(*curve.evaluate(u).T)
+        radius = np.hypot(*curve.evaluate(np.linspace(*curve.domain, 200_001)).T)
         assert np.max(np.abs(radius - 30.0)) <= TOL
+    u = np.linspace(0.0, 1.0, 200_001)
     assert np.max(np.abs(np.hypot(*fit.curve.evaluate(u).T) - 30.0)) == pytest.approx(fit.max_error, rel=0.02)
 
 
@@ -134,28 +134,49 @@ def test_seam_is_smooth_where_the_profile_is():
         assert fit.seam_curvature_jump < 1e-9
 
 
-def test_harmonic_seam_keeps_the_profiles_curvature_jump(harmonic):
-    _, _, fit = harmonic
-    # φ = 0 joins dwell and rise; for r = R + s: κ = (r² + 2r'² − r r'')/(r² + r'²)^{3/2},
-    # r' = 0 there, so Δκ = s''/R² with s'' = (h/2)(π/β)² (double knot: C1 curve).
+def curvature(curve, u):
+    d1, d2 = curve.evaluate(u, 1), curve.evaluate(u, 2)
+    return (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.hypot(*d1.T) ** 3
+
+
+def test_harmonic_seam_is_smooth_and_keeps_off_the_profiles_curvature_jump(harmonic):
+    _, exact, fit = harmonic
     assert fit.seam_tangent_jump < 1e-9
+    assert fit.seam_curvature_jump < 1e-9
+    # the clamped form opens mid-rise (longest stretch 0°–150°), a quarter stretch from φ = 0 and 150°
+    start = fit.clamped.evaluate(np.array([fit.clamped.domain[0]]))
+    dense = np.arange(3600) * 2 * np.pi / 3600
+    phi_start = dense[np.argmin(np.hypot(*(exact(dense) - start).T))]
+    assert 37.5 * DEG <= phi_start <= 112.5 * DEG
+    # φ = 0 joins dwell and rise; for r = R + s: κ = (r² + 2r'² − r r'')/(r² + r'²)^{3/2},
+    # r' = 0 there, so Δκ = s''/R² with s'' = (h/2)(π/β)² (double knot: C1 curve). The
+    # clamped form keeps that jump inside, at the curve's parameter of φ = 0.
+    knots, counts = np.unique(fit.curve.knots, return_counts=True)
+    assert counts[knots == 0.0] == 2
+    u0 = 1.0 - fit.seam  # φ = 0 (u = 0 on the periodic curve) on the clamped form
+    left, right = curvature(fit.clamped, np.array([u0 - 1e-9, u0 + 1e-9]))
     expected = 0.5 * RISE * (np.pi / BETA) ** 2 / BASE**2
-    assert fit.seam_curvature_jump == pytest.approx(expected, rel=0.05)
+    assert abs(right - left) == pytest.approx(expected, rel=0.05)
 
 
 def test_clamped_and_periodic_forms_agree(cam):
     _, _, fit = cam
-    u = np.linspace(0.0, 1.0, 20_001)
-    assert_allclose(fit.clamped.evaluate(u), fit.curve.evaluate(u), rtol=0, atol=1e-9)
+    assert fit.clamped.domain == (0.0, 1.0)
+    assert 0.0 < fit.seam < 1.0
+    v = np.linspace(0.0, 1.0, 20_001)
+    assert_allclose(fit.clamped.evaluate(v), fit.curve.evaluate(v + fit.seam), rtol=0, atol=1e-9)
+    # the same point set, also read from the periodic curve's side
+    assert_allclose(fit.clamped.evaluate(np.mod(v - fit.seam, 1.0)), fit.curve.evaluate(v), rtol=0, atol=1e-9)
     assert np.array_equal(fit.clamped.control_points[0], fit.clamped.control_points[-1])
     assert fit.control_points == len(fit.clamped.control_points)
 
 
 def test_geomdl_agrees_with_the_fit(cam):
     _, _, fit = cam
-    crv = to_geomdl(fit.curve)
-    u = np.linspace(0.0, 1.0, 2001)
-    assert_allclose(np.array(crv.evaluate_list(u.tolist())), fit.curve.evaluate(u), rtol=0, atol=1e-9)
+    crv = to_geomdl(fit.clamped)
+    v = np.linspace(0.0, 1.0, 2001)
+    theirs = np.array(crv.evaluate_list(v.tolist()))
+    assert_allclose(theirs, fit.curve.evaluate(v + fit.seam), rtol=0, atol=1e-9)
 
 
 def test_params_are_foot_points(cam):
@@ -163,6 +184,9 @@ def test_params_are_foot_points(cam):
     assert np.all(np.diff(fit.params) > 0)
     on_curve = fit.curve.evaluate(fit.params)
     assert np.max(np.hypot(*(on_curve - exact(PHI)).T)) <= fit.max_error + 1e-9
+    on_clamped = fit.clamped.evaluate(fit.clamped_params)
+    assert np.all((fit.clamped_params >= 0.0) & (fit.clamped_params < 1.0))
+    assert_allclose(on_clamped, on_curve, rtol=0, atol=1e-9)
 
 
 def test_double_knots_at_c1_breakpoints_save_control_points(harmonic):
