@@ -159,3 +159,41 @@ def test_chords_deviation_is_their_sagitta():
     pc = chord_pieces(phi[:-1], phi[1:], p[:-1], t[:-1], p[1:], t[1:])
     sagitta = 10.0 * (1.0 - math.cos(math.pi / n))
     assert_allclose(measure_deviation(circle, pc, samples=101), sagitta, rtol=1e-3)
+
+
+def _piece_tangents(pieces):
+    """Unit tangents (m, 2) at the start and at the end of every non-empty piece, in path order."""
+    starts, ends = [], []
+    for i in range(len(pieces)):
+        for k in (0, 1):
+            s, e = pieces.start[i, k], pieces.end[i, k]
+            if np.array_equal(s, e):
+                continue
+            if pieces.line[i, k]:
+                d = (e - s) / np.linalg.norm(e - s)
+                starts.append(d)
+                ends.append(d)
+                continue
+            sign = 1.0 if pieces.ccw[i, k] else -1.0
+            for p, out in ((s, starts), (e, ends)):
+                rad = (p - pieces.center[i, k]) / np.linalg.norm(p - pieces.center[i, k])
+                out.append(sign * np.array([-rad[1], rad[0]]))
+    return np.array(starts), np.array(ends)
+
+
+def test_soft_nodes_end_an_arc_in_the_band_of_one_closed_interval():
+    curve, tol = wobble(), 0.004
+    nodes = [1.0, 2.5, 4.0]
+    pieces, dev = fit_curve(curve, [0.0, 2 * np.pi], tol, nodes=nodes)
+    assert dev.max() <= tol
+    for phi in nodes:  # an arc ends at each node, within the band abeam C(φ)
+        i = int(np.flatnonzero(pieces.hi == phi)[0])
+        end = pieces.end[i, 1]
+        assert np.linalg.norm(end - curve(np.array([phi]))[0][0]) <= tol
+    # one closed, tangent-continuous path, starting and ending on the curve's tangent at φ = 0
+    assert_allclose(pieces.end[:-1, 1], pieces.start[1:, 0], atol=0)
+    starts, ends = _piece_tangents(pieces)
+    assert_allclose(ends[:-1], starts[1:], atol=1e-9)
+    assert_allclose(starts[0], [0.0, 1.0], atol=1e-9)
+    assert_allclose(ends[-1], [0.0, 1.0], atol=1e-9)
+    assert_allclose(pieces.end[-1, 1], pieces.start[0, 0], atol=1e-9)

@@ -26,6 +26,7 @@ __all__ = ["DECIMALS", "Contour", "fit_contour", "offset_curve", "round_mm", "ro
 DECIMALS = 4
 LINE_SAGITTA = 0.05  # × tolerance: an arc bulging less is written as G1
 _MERGE = 2e-4  # mm: consecutive arcs with centres and radii this close are one circle
+_SNAP = 1e-3  # mm: a tab edge this close to a step's end is put there (the fit ends an arc abeam it)
 
 
 def offset_curve(cam: Cam, distance: float) -> CurveFn:
@@ -180,6 +181,7 @@ def _split_tabs(steps: list[Step], edges: FloatArray) -> list[Step]:
         j = int(np.argmin([d[0] for d in dist]))
         point = round_point(dist[j][1:])
         st = steps[j]
+        point = next((e for e in (st.start, st.end) if math.dist(e, point) <= _SNAP), point)
         along = (
             math.dist(st.start, point) if st.center is None else _turn(st.kind, st.start, point, st.center)
         )
@@ -228,7 +230,8 @@ def fit_contour(
     clockwise
         Travel clockwise around the part (climb milling outside).
     windows
-        φ-windows [rad] over tabs; steps are split at their edges.
+        φ-windows [rad] over tabs; steps are split at their edges (with arcs,
+        the fit ends an arc abeam each edge, so a split adds no step).
     arcs
         False for G1 chords only.
 
@@ -241,7 +244,8 @@ def fit_contour(
     """
     curve = offset_curve(cam, distance)
     try:
-        pieces, _ = fit_curve(curve, breaks, fit_tol, arcs=arcs)
+        edges = [a for w in windows for a in w]
+        pieces, _ = fit_curve(curve, breaks, fit_tol, arcs=arcs, nodes=edges)
     except ValueError as err:  # pragma: no cover - only for a cusp the gouge check missed
         raise DesignLimitError(f"cannot fit the toolpath: {err}") from err
     reverse = (_signed_area(pieces) > 0.0) == clockwise

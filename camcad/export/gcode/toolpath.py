@@ -221,12 +221,13 @@ def _lead_radius(
 
 
 def _breaks(cam: Cam, phi0: float) -> FloatArray:
-    """Fit breaks [rad]: the start angle, every motion breakpoint after it, and start + 2π.
+    """Fit breaks [rad]: the start angle, every breakpoint after it where the velocity jumps, and start + 2π.
 
-    Nodes at the breakpoints, where the curvature or its rate jumps, let each
-    biarc follow one smooth piece (measured: fewer blocks than free nodes).
+    The arc search passes over breakpoints where only the curvature (or its
+    rate) jumps, ending arcs wherever they reach (measured: fewer blocks than
+    nodes held on the curve there); a velocity jump is a corner and keeps a node.
     """
-    joints = [phi0 + (bp.phi - phi0) % TWO_PI for bp in cam.program.breakpoints]
+    joints = [phi0 + (bp.phi - phi0) % TWO_PI for bp in cam.program.breakpoints if bp.continuity < 1]
     pts: FloatArray = np.unique(np.asarray([phi0, *joints, phi0 + TWO_PI]))
     keep = np.concatenate(([True], np.diff(pts) > _BREAK_MERGE))
     out = pts[keep]
