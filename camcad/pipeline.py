@@ -9,9 +9,6 @@ the output folder only when every stage has succeeded.
 from __future__ import annotations
 
 import math
-import os
-import shutil
-import tempfile
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -24,6 +21,7 @@ from camcad.analysis import Analysis, motion_summary
 from camcad.design import Design, load_design
 from camcad.dynamics import analyse_dynamics
 from camcad.errors import DesignError
+from camcad.export.atomic import staged_folder
 from camcad.export.records import write_csv, write_json, write_text
 from camcad.fit import fit_cam_profile
 from camcad.geometry import Cam, analyse_geometry, undercut_error
@@ -187,23 +185,6 @@ def _groups(only: Iterable[str] | None) -> set[str]:
     return chosen
 
 
-def _prepare_outdir(outdir: Path) -> Path:
-    """Check that ``outdir`` can be created or written; return a temporary sibling folder."""
-    if outdir.exists() and not outdir.is_dir():
-        raise DesignError("--output", f"{outdir} exists and is not a folder")
-    parent = outdir.parent if outdir.parent != Path("") else Path(".")
-    probe = parent
-    while not probe.exists():
-        probe = probe.parent
-    if not probe.is_dir() or not os.access(probe, os.W_OK):
-        raise DesignError("--output", f"cannot create {outdir}: {probe} is not a writable folder")
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        return Path(tempfile.mkdtemp(prefix=f".{outdir.name}.camcad-", dir=parent))
-    except OSError as err:
-        raise DesignError("--output", f"cannot write to {parent}: {err.strerror or err}") from None
-
-
 def build(
     design: Design,
     outdir: str | Path,
@@ -219,15 +200,11 @@ def build(
     """
     groups = _groups(only)
     outdir = Path(outdir)
-    tmp = _prepare_outdir(outdir)
-    try:
+    with staged_folder(outdir) as staging:
         analysis = analyse(design, fit=True, toolpath="gcode" in groups, progress=progress)
-        written = _write_outputs(analysis, tmp, groups=groups, progress=progress)
-        written.append(write_json(tmp / "summary.json", analysis.summary()))
-        final = _commit(tmp, outdir, [Path(p).name for p in written])
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return BuildResult(analysis=analysis, outdir=outdir, files=tuple(final))
+        written = _write_outputs(analysis, staging.path, groups=groups, progress=progress)
+        written.append(write_json(staging.path / "summary.json", analysis.summary()))
+    return BuildResult(analysis=analysis, outdir=outdir, files=tuple(outdir / Path(p).name for p in written))
 
 
 def _write_outputs(
@@ -324,13 +301,3 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
         write_points_csv(folder / "points.csv", cam, design),
         write_lift_csv(folder / "lift.csv", cam, design),
     ]
-
-
-def _commit(tmp: Path, outdir: Path, names: list[str]) -> list[Path]:
-    """Move the finished files into ``outdir`` (each move an atomic rename)."""
-    outdir.mkdir(parents=True, exist_ok=True)
-    final = []
-    for name in names:
-        os.replace(tmp / name, outdir / name)
-        final.append(outdir / name)
-    return final

@@ -12,12 +12,16 @@ from __future__ import annotations
 
 import os
 import secrets
-from collections.abc import Callable
+import shutil
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
-from camcad.errors import ExportError
+from camcad.errors import DesignError, ExportError
 
-__all__ = ["atomic_write", "atomic_write_bytes", "atomic_write_text"]
+__all__ = ["StagedFolder", "atomic_write", "atomic_write_bytes", "atomic_write_text", "staged_folder"]
 
 
 def _temporary_sibling(path: Path) -> Path:
@@ -88,3 +92,53 @@ def atomic_write_text(path: str | os.PathLike[str], text: str, *, encoding: str 
             handle.write(text)
 
     return atomic_write(path, write)
+
+
+@dataclass(frozen=True, slots=True)
+class StagedFolder:
+    """A temporary folder beside the output folder; ``path`` is where files are written."""
+
+    path: Path
+    target: Path
+
+
+def _staging_path(outdir: Path) -> Path:
+    """Check that ``outdir`` can be created or written; make a temporary sibling folder."""
+    if outdir.exists() and not outdir.is_dir():
+        raise DesignError("--output", f"{outdir} exists and is not a folder")
+    parent = outdir.parent if outdir.parent != Path("") else Path(".")
+    probe = parent
+    while not probe.exists():
+        probe = probe.parent
+    if not probe.is_dir() or not os.access(probe, os.W_OK):
+        raise DesignError("--output", f"cannot create {outdir}: {probe} is not a writable folder")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        return Path(tempfile.mkdtemp(prefix=f".{outdir.name}.camcad-", dir=parent))
+    except OSError as err:
+        raise DesignError("--output", f"cannot write to {parent}: {err.strerror or err}") from None
+
+
+@contextmanager
+def staged_folder(outdir: str | os.PathLike[str]) -> Iterator[StagedFolder]:
+    """Write a set of files all or nothing.
+
+    Yields a temporary folder beside ``outdir``. When the block ends normally
+    every file in it is moved into ``outdir`` (created if needed), each by an
+    atomic rename; when the block raises, the temporary folder is removed and
+    ``outdir`` is left exactly as it was. Either way nothing temporary stays.
+
+    Raises
+    ------
+    DesignError
+        With path ``--output`` when ``outdir`` cannot be created or written.
+    """
+    target = Path(outdir)
+    staging = StagedFolder(path=_staging_path(target), target=target)
+    try:
+        yield staging
+        target.mkdir(parents=True, exist_ok=True)
+        for item in sorted(staging.path.iterdir()):
+            os.replace(item, target / item.name)
+    finally:
+        shutil.rmtree(staging.path, ignore_errors=True)
