@@ -5,7 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from camcad.design import Design, parse_design
 
@@ -48,3 +50,16 @@ def make_design(
 def sample_path(request: pytest.FixtureRequest) -> Path:
     """Each shipped sample design file."""
     return request.param
+
+
+def distance_to_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """Distance of each point to a closed polygon (first vertex not repeated), near its nearest vertex."""
+    n = len(polygon)
+    _, nearest = cKDTree(polygon).query(points)
+    dist = np.full(len(points), np.inf)
+    for shift in (-1, 0):
+        i = (nearest + shift) % n
+        p, q = polygon[i], polygon[(i + 1) % n]
+        t = np.clip(np.einsum("ij,ij->i", points - p, q - p) / np.einsum("ij,ij->i", q - p, q - p), 0, 1)
+        dist = np.minimum(dist, np.linalg.norm(points - (p + t[:, None] * (q - p)), axis=1))
+    return dist

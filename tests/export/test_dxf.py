@@ -24,7 +24,7 @@ from camcad.export.dxf import (
 )
 from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.geometry.cam import Cam
-from tests.conftest import make_design
+from tests.conftest import distance_to_polygon, make_design
 
 KEYED = {"cam": {"bore": 12.0, "keyway_width": 4.0, "keyway_depth": 2.0}}
 DESIGNS = {
@@ -42,19 +42,6 @@ def cam_and_fit(design: Design) -> tuple[Cam, ProfileFit]:
     return cam, fit_cam_profile(
         cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
     )
-
-
-def distance_to_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
-    """Distance of each point to a closed polygon (first vertex not repeated), near its nearest vertex."""
-    n = len(polygon)
-    _, nearest = cKDTree(polygon).query(points)
-    dist = np.full(len(points), np.inf)
-    for shift in (-1, 0):
-        i = (nearest + shift) % n
-        p, q = polygon[i], polygon[(i + 1) % n]
-        t = np.clip(np.einsum("ij,ij->i", points - p, q - p) / np.einsum("ij,ij->i", q - p, q - p), 0, 1)
-        dist = np.minimum(dist, np.linalg.norm(points - (p + t[:, None] * (q - p)), axis=1))
-    return dist
 
 
 def lwpolyline_outline(entity, samples: int = 20000) -> np.ndarray:

@@ -15,7 +15,6 @@ import pytest
 import trimesh
 from numpy.testing import assert_allclose
 from scipy.interpolate import make_interp_spline
-from scipy.spatial import cKDTree
 
 from camcad.design import Design
 from camcad.errors import ExportError
@@ -34,7 +33,7 @@ from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.fit.bspline import clamped_from_periodic
 from camcad.fit.curve import BSplineCurve
 from camcad.geometry.cam import Cam
-from tests.conftest import make_design
+from tests.conftest import distance_to_polygon, make_design
 
 KEYED = {"cam": {"bore": 12.0, "keyway_width": 4.0, "keyway_depth": 2.0}}
 
@@ -64,19 +63,6 @@ def circle_spline(radius: float = 30.0, n: int = 24) -> BSplineCurve:
     pts[-1] = pts[0]
     spl = make_interp_spline(t, pts, k=3, bc_type="periodic")
     return clamped_from_periodic(BSplineCurve(degree=3, knots=spl.t, control_points=spl.c, periodic=True))
-
-
-def distance_to_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
-    """Distance of each point to a closed polygon (first vertex not repeated), near its nearest vertex."""
-    n = len(polygon)
-    _, nearest = cKDTree(polygon).query(points)
-    dist = np.full(len(points), np.inf)
-    for shift in (-1, 0):
-        i = (nearest + shift) % n
-        p, q = polygon[i], polygon[(i + 1) % n]
-        t = np.clip(np.einsum("ij,ij->i", points - p, q - p) / np.einsum("ij,ij->i", q - p, q - p), 0, 1)
-        dist = np.minimum(dist, np.linalg.norm(points - (p + t[:, None] * (q - p)), axis=1))
-    return dist
 
 
 @pytest.mark.parametrize("tol", [0.5, 0.05, 0.005], ids=["0.5", "0.05", "0.005"])
