@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -17,22 +16,42 @@ from camcad.export.atomic import atomic_write_text
 
 __all__ = ["csv_text", "write_csv", "write_json", "write_text"]
 
-CSV_FORMAT = "%.9g"
-"""Nine significant digits: sub-micrometre on a 1 m cam, stable for diffs."""
+CSV_FORMAT = "{:.9g}"
+"""Default cell format, nine significant digits: sub-micrometre on a 1 m cam, stable for diffs."""
 
 
-def csv_text(columns: Mapping[str, ArrayLike]) -> str:
-    """CSV with one header line and one row per sample; every column the same length."""
+def _cell(fmt: str, value: float) -> str:
+    text = fmt.format(value)
+    if text.startswith("-") and float(text) == 0.0:
+        text = text[1:]  # no "-0": the same table on every platform
+    return text
+
+
+def csv_text(columns: Mapping[str, ArrayLike], *, formats: Sequence[str] | None = None) -> str:
+    """CSV with one header line and one row per sample; every column the same length.
+
+    Parameters
+    ----------
+    columns
+        Header name → (n,) values, in column order.
+    formats
+        One ``str.format`` spec per column (e.g. ``"{:.6f}"``); default
+        :data:`CSV_FORMAT` for all.
+    """
     names = list(columns)
-    data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
-    buf = io.StringIO()
-    np.savetxt(buf, data, delimiter=",", header=",".join(names), comments="", fmt=CSV_FORMAT)
-    return buf.getvalue()
+    fmts = list(formats) if formats is not None else [CSV_FORMAT] * len(names)
+    data = [np.asarray(columns[n], dtype=float).ravel().tolist() for n in names]
+    lines = [",".join(names)]
+    for values in zip(*data, strict=True):
+        lines.append(",".join(_cell(f, v) for f, v in zip(fmts, values, strict=True)))
+    return "\n".join(lines) + "\n"
 
 
-def write_csv(path: str | os.PathLike[str], columns: Mapping[str, ArrayLike]) -> Path:
+def write_csv(
+    path: str | os.PathLike[str], columns: Mapping[str, ArrayLike], *, formats: Sequence[str] | None = None
+) -> Path:
     """Atomically write a CSV table (see :func:`csv_text`)."""
-    return atomic_write_text(path, csv_text(columns))
+    return atomic_write_text(path, csv_text(columns, formats=formats))
 
 
 def _clean(value: Any) -> Any:

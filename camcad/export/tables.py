@@ -38,7 +38,7 @@ import numpy as np
 from camcad._typing import FloatArray, readonly
 from camcad.design import Design, Rotation
 from camcad.errors import ExportError
-from camcad.export.atomic import atomic_write_text
+from camcad.export.records import write_csv
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -132,20 +132,6 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation) -> FloatArr
     return out
 
 
-def _cell(fmt: str, value: float) -> str:
-    text = fmt.format(value)
-    if text.startswith("-") and float(text) == 0.0:
-        text = text[1:]  # no "-0.000000": the same table on every platform
-    return text
-
-
-def _rows(columns: list[FloatArray], formats: list[str]) -> str:
-    lines = []
-    for values in zip(*(c.tolist() for c in columns), strict=True):
-        lines.append(",".join(_cell(fmt, v) for fmt, v in zip(formats, values, strict=True)))
-    return "\n".join(lines) + "\n"
-
-
 def write_points_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> Path:
     """Write ``points.csv``: profile points per cam angle (module docstring).
 
@@ -173,8 +159,8 @@ def write_points_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> 
         prof.normal[:, 1],
         prof.rho,
     ]
-    body = _rows(columns, ["{:.6f}", "{:.6f}", "{:.6f}", "{:.9f}", "{:.9f}", "{:.6f}"])
-    return atomic_write_text(path, POINTS_HEADER + "\n" + body)
+    formats = ["{:.6f}", "{:.6f}", "{:.6f}", "{:.9f}", "{:.9f}", "{:.6f}"]
+    return write_csv(path, dict(zip(POINTS_HEADER.split(","), columns, strict=True)), formats=formats)
 
 
 def write_lift_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> Path:
@@ -202,5 +188,5 @@ def write_lift_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> Pa
     angle = table_angles(design.tables.step)
     lift = cam.motion(angle).s
     radius = polar_radius(cam, angle, rotation=design.cam.rotation)
-    body = _rows([np.degrees(angle), lift, radius], ["{:.6f}", "{:.6f}", "{:.6f}"])
-    return atomic_write_text(path, LIFT_HEADER + "\n" + body)
+    columns = dict(zip(LIFT_HEADER.split(","), [np.degrees(angle), lift, radius], strict=True))
+    return write_csv(path, columns, formats=["{:.6f}"] * 3)
