@@ -64,6 +64,17 @@ class Plot:
 # helpers
 
 
+def _plan_axes(ax: Axes, lim: float) -> None:
+    """A to-scale plan view of the cam frame, ±``lim`` mm on both axes."""
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]", fontsize=9)
+    ax.set_ylabel("y [mm]", fontsize=9)
+    ax.tick_params(labelsize=8)
+    ax.grid(True, color="#eeeeee", linewidth=0.6)
+
+
 def _figure(size: tuple[float, float] = _WIDE) -> Figure:
     """A new off-screen figure with the Agg canvas attached (no pyplot)."""
     fig = Figure(figsize=size, dpi=_DPI, layout="constrained")
@@ -350,13 +361,7 @@ def _profile_plot(analysis: Analysis) -> Plot:
         va="center",
     )
     lim = far + 0.3 * reach  # room for the labels beyond the stem tips
-    ax.set_xlim(-lim, lim)
-    ax.set_ylim(-lim, lim)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [mm]", fontsize=9)
-    ax.set_ylabel("y [mm]", fontsize=9)
-    ax.tick_params(labelsize=8)
-    ax.grid(True, color="#eeeeee", linewidth=0.6)
+    _plan_axes(ax, lim)
     ax.set_axisbelow(True)
     ax.legend(fontsize=8, loc="lower right", framealpha=0.9)
     kind = "roller" if cam.is_roller else "flat-face"
@@ -425,13 +430,7 @@ def _compare_profiles(analyses: Sequence[Analysis], names: Sequence[str]) -> Plo
         ax.plot(pts[:, 0], pts[:, 1], color=_COLORS[n % len(_COLORS)], linewidth=1.3, label=name)
     ax.plot(0.0, 0.0, marker="+", color="black")
     lim = 1.1 * reach
-    ax.set_xlim(-lim, lim)
-    ax.set_ylim(-lim, lim)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [mm]", fontsize=9)
-    ax.set_ylabel("y [mm]", fontsize=9)
-    ax.tick_params(labelsize=8)
-    ax.grid(True, color="#eeeeee", linewidth=0.6)
+    _plan_axes(ax, lim)
     handles, labels = ax.get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncol=1, fontsize=8)
     return Plot(
