@@ -12,10 +12,13 @@ import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from camcad._version import __version__
 from camcad.errors import CamcadError, DesignLimitError, exit_code
+
+if TYPE_CHECKING:
+    from camcad.pipeline import Progress
 
 __all__ = ["build_parser", "main"]
 
@@ -29,7 +32,7 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_INVALID, f"camcad: error: {message} (see '{self.prog} --help')\n")
 
 
-def _progress(quiet: bool):
+def _progress(quiet: bool) -> Progress | None:
     if quiet:
         return None
 
@@ -63,7 +66,7 @@ def _fmt(value: Any, unit: str = "", digits: int = 3) -> str:
         return "—"
     if isinstance(value, bool):
         return "yes" if value else "no"
-    if isinstance(value, (int,)):
+    if isinstance(value, int):
         return f"{value}{unit}"
     return f"{value:.{digits}f}{unit}"
 

@@ -568,7 +568,7 @@ def _check_design(design: Design) -> None:
                 f"|{fol.offset:g}| must be smaller than base_radius + roller_radius = "
                 f"{cam.base_radius + fol.roller_radius:g} mm",
             )
-    bore_reach = max(cam.bore / 2.0, cam.bore / 2.0 + cam.keyway_depth if cam.keyway_width else 0)
+    bore_reach = cam.bore / 2.0 + (cam.keyway_depth if cam.keyway_width else 0.0)
     if bore_reach >= cam.base_radius:
         raise DesignError(
             "cam.bore",

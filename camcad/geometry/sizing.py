@@ -51,8 +51,6 @@ def feasible_margins(
         rho_profile = cam.profile(phi).rho
     i_rho = int(np.argmin(rho_profile))
     margin_rho = float(rho_profile[i_rho]) - min_curvature_radius
-    if min_curvature_radius == 0.0 and margin_rho == 0.0:
-        margin_rho = -0.0
     return max_pressure_angle - float(alpha[i_alpha]), margin_rho, i_alpha, i_rho
 
 
