@@ -136,7 +136,11 @@ def analyse(
         progress,
         "dynamics",
         lambda: analyse_dynamics(
-            motion, pressure_angle=geometry.pressure_angle, profile_rho=geometry.profile.rho, design=design
+            motion,
+            pressure_angle=geometry.pressure_angle,
+            profile_rho=geometry.profile.rho,
+            design=design,
+            cam=cam,
         ),
     )
     fitted = None

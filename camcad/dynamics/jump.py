@@ -24,6 +24,7 @@ __all__ = [
     "loss_runs",
     "min_preload",
     "speed_limits",
+    "speed_window",
 ]
 
 TWO_PI = 2.0 * math.pi
@@ -104,7 +105,13 @@ def speed_limits(
     upper = bound[a < 0.0]
     lower = bound[a > 0.0]
     w2_high = float(np.min(upper)) if upper.size else math.inf
-    w2_low = max(0.0, float(np.max(lower))) if lower.size else 0.0
+    w2_low = float(np.max(lower)) if lower.size else 0.0
+    return speed_window(w2_low, w2_high)
+
+
+def speed_window(w2_low: float, w2_high: float) -> tuple[float, float] | None:
+    """(ω_low, ω_high) [rad/s] from the bounds ω² ≥ ``w2_low`` and ω² ≤ ``w2_high`` [rad²/s²], or None."""
+    w2_low = max(0.0, w2_low)
     if w2_high < 0.0 or w2_low > w2_high:
         return None
     return math.sqrt(w2_low), math.sqrt(w2_high)

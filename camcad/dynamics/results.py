@@ -17,6 +17,7 @@ from camcad._typing import FloatArray
 from camcad.design import DynamicsModel
 from camcad.dynamics.jump import covering_arc
 from camcad.errors import JumpError
+from camcad.extremes import SIDE_WORDS, Extreme
 
 __all__ = ["CSV_HEADER", "DynamicsResult"]
 
@@ -70,6 +71,10 @@ class DynamicsResult:
         ``[dynamics].allowable_stress`` [MPa] or ``None``.
     warnings
         Findings for the report, one sentence each.
+    contact_force_min, contact_force_max, torque_min, torque_max, hertz_stress_max
+        True extremes over the turn (one-sided limits at joints included), when
+        the analysis had the exact cam; else ``None`` and the summary falls back
+        to the samples.
     """
 
     model: DynamicsModel
@@ -87,6 +92,11 @@ class DynamicsResult:
     speed_range_rpm: tuple[float, float] | None = None
     allowable_stress: float | None = None
     warnings: tuple[str, ...] = ()
+    contact_force_min: Extreme | None = None
+    contact_force_max: Extreme | None = None
+    torque_min: Extreme | None = None
+    torque_max: Extreme | None = None
+    hertz_stress_max: Extreme | None = None
 
     csv_header: ClassVar[tuple[str, ...]] = CSV_HEADER
 
@@ -106,30 +116,38 @@ class DynamicsResult:
         Returns
         -------
         dict[str, Any]
-            ``torque_max_Nmm``, ``torque_max_angle_deg``, ``torque_min_Nmm``,
-            ``torque_min_angle_deg``, ``contact_force_max_N``,
-            ``contact_force_min_N``, ``jump`` (bool), ``jump_range_deg``
-            ([start, end] in degrees, start > end through 0°, or ``None``),
-            ``hertz_stress_max_MPa``, ``hertz_stress_max_angle_deg`` and
-            ``warnings`` (list of str). Plain Python values, JSON-ready.
+            For each of ``torque_max``, ``torque_min``, ``contact_force_max``,
+            ``contact_force_min`` and ``hertz_stress_max``: the value
+            (``_Nmm``, ``_N``, ``_MPa``), ``_angle_deg`` and ``_side``
+            (``"before joint"``/``"after joint"`` for a one-sided limit, else
+            ``None``); then ``jump`` (bool), ``jump_range_deg`` ([start, end]
+            in degrees, start > end through 0°, or ``None``),
+            ``min_preload_N``, ``speed_range_rpm`` ([low, high] or ``None``)
+            and ``warnings`` (list of str). Plain Python values, JSON-ready.
         """
-        k_max = int(np.argmax(self.torque))
-        k_min = int(np.argmin(self.torque))
-        k_stress = int(np.argmax(self.hertz_stress))
         arc = self.jump_range
-        return {
-            "torque_max_Nmm": float(self.torque[k_max]),
-            "torque_max_angle_deg": _deg(float(self.phi[k_max])),
-            "torque_min_Nmm": float(self.torque[k_min]),
-            "torque_min_angle_deg": _deg(float(self.phi[k_min])),
-            "contact_force_max_N": float(np.max(self.contact_force)),
-            "contact_force_min_N": float(np.min(self.contact_force)),
+        out: dict[str, Any] = {}
+        for key, unit, ext, values, kind in (
+            ("torque_max", "Nmm", self.torque_max, self.torque, "max"),
+            ("torque_min", "Nmm", self.torque_min, self.torque, "min"),
+            ("contact_force_max", "N", self.contact_force_max, self.contact_force, "max"),
+            ("contact_force_min", "N", self.contact_force_min, self.contact_force, "min"),
+            ("hertz_stress_max", "MPa", self.hertz_stress_max, self.hertz_stress, "max"),
+        ):
+            if ext is None:
+                i = int(np.argmax(values) if kind == "max" else np.argmin(values))
+                ext = Extreme(value=float(values[i]), phi=float(self.phi[i]))
+            out[f"{key}_{unit}"] = ext.value
+            out[f"{key}_angle_deg"] = round(ext.angle_deg, 6)
+            out[f"{key}_side"] = None if ext.side is None else SIDE_WORDS[ext.side]
+        out |= {
             "jump": self.jump,
             "jump_range_deg": None if arc is None else [_deg(arc[0]), _deg(arc[1])],
-            "hertz_stress_max_MPa": float(self.hertz_stress[k_stress]),
-            "hertz_stress_max_angle_deg": _deg(float(self.phi[k_stress])),
+            "min_preload_N": self.min_preload,
+            "speed_range_rpm": None if self.speed_range_rpm is None else list(self.speed_range_rpm),
             "warnings": list(self.warnings),
         }
+        return out
 
     def table(self) -> FloatArray:
         """(n, 4) array of the ``dynamics.csv`` columns (see ``csv_header``).

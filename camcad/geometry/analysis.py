@@ -7,10 +7,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy.optimize import brentq
 
 from camcad._typing import FloatArray, readonly
 from camcad.angles import flagged_ranges, format_ranges
 from camcad.errors import UndercutError
+from camcad.extremes import SIDE_WORDS, Extreme, Quantity, Side, extremes, maximum, minimum
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.sizing import min_base_radius
@@ -18,6 +20,7 @@ from camcad.geometry.sizing import min_base_radius
 __all__ = ["GeometryAnalysis", "Undercut", "analyse_geometry", "undercut_error"]
 
 _SUGGEST_ROUND_MM = 0.01
+TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -32,13 +35,21 @@ class Undercut:
     ranges: tuple[tuple[float, float], ...]
     worst: float
     worst_angle: float
+    worst_side: Side | None = None  # the worst value is the limit just before/after a joint
+
+    def where(self) -> str:
+        """``"at 29.9°"`` or ``"at 90.0° (just before the joint)"``."""
+        return Extreme(value=self.worst, phi=self.worst_angle, side=self.worst_side).where()
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class GeometryAnalysis:
-    """A cam's geometry sampled over one turn, with its limits checked.
+    """A cam's geometry sampled over one turn, with its limits checked at true extremes.
 
-    Arrays are (n,) over ``phi`` [rad]; ``pressure_angle`` rad; radii mm.
+    Arrays are (n,) over ``phi`` [rad]; ``pressure_angle`` rad; radii mm. The
+    :class:`~camcad.extremes.Extreme` fields are the true extremes over the
+    turn (one-sided limits at joints included, interior extrema refined on the
+    exact curves), not the extremes of the samples.
     """
 
     cam: Cam
@@ -50,7 +61,12 @@ class GeometryAnalysis:
     max_pressure_angle: float  # rad, the design limit
     undercut: Undercut | None
     warnings: tuple[str, ...]
-    face_width_min: float | None  # mm, flat follower only
+    face_width_min: float | None  # mm, flat follower only: twice the largest contact excursion
+    pressure_angle_max: Extreme  # of |α| [rad]
+    profile_radius_min: Extreme  # polar radius of the contact point [mm]
+    profile_radius_max: Extreme
+    curvature_radius_min: Extreme | None  # smallest convex profile radius [mm]; None if none convex
+    concave_radius_min: Extreme | None  # smallest concave profile radius [mm] (positive); None if none
 
     @property
     def profile_radius(self) -> FloatArray:
@@ -58,35 +74,77 @@ class GeometryAnalysis:
         return np.hypot(self.profile.point[:, 0], self.profile.point[:, 1])
 
     def summary(self) -> dict[str, Any]:
-        """The ``geometry`` section of summary.json (angles in degrees, lengths mm)."""
-        alpha = np.abs(self.pressure_angle)
-        i = int(np.argmax(alpha))
-        rho = self.profile.rho
-        convex = rho > 0
-        concave = rho < 0
-        radius = self.profile_radius
-        out: dict[str, Any] = {
-            "pressure_angle_max_deg": math.degrees(float(alpha[i])),
-            "pressure_angle_max_angle_deg": math.degrees(float(self.phi[i])),
-            "profile_radius_min_mm": float(radius.min()),
-            "profile_radius_max_mm": float(radius.max()),
-            "curvature_radius_min_mm": float(rho[convex].min()) if convex.any() else None,
-            "curvature_radius_min_angle_deg": (
-                math.degrees(float(self.phi[convex][np.argmin(rho[convex])])) if convex.any() else None
-            ),
-            "concave_radius_min_mm": float(-rho[concave].max()) if concave.any() else None,
-            "undercut": self.undercut is not None,
-            "warnings": list(self.warnings),
-        }
+        """The ``geometry`` section of summary.json (angles in degrees, lengths mm).
+
+        Every extreme is the true one; ``*_side`` says ``"before joint"`` or
+        ``"after joint"`` where it is a one-sided limit at a joint, else null.
+        """
+        out: dict[str, Any] = {}
+        _put(out, "pressure_angle_max", self.pressure_angle_max, scale=180.0 / math.pi, unit="deg")
+        _put(out, "profile_radius_min", self.profile_radius_min, unit="mm")
+        _put(out, "profile_radius_max", self.profile_radius_max, unit="mm")
+        _put(out, "curvature_radius_min", self.curvature_radius_min, unit="mm")
+        _put(out, "concave_radius_min", self.concave_radius_min, unit="mm")
+        out["undercut"] = self.undercut is not None
+        out["warnings"] = list(self.warnings)
         if self.face_width_min is not None:
             out["face_width_min_mm"] = self.face_width_min
         return out
 
 
+def _put(out: dict[str, Any], key: str, ext: Extreme | None, *, unit: str, scale: float = 1.0) -> None:
+    """``key_unit``, ``key_angle_deg`` and ``key_side`` of an extreme (all None when absent)."""
+    out[f"{key}_{unit}"] = None if ext is None else ext.value * scale
+    out[f"{key}_angle_deg"] = None if ext is None else ext.angle_deg
+    out[f"{key}_side"] = None if ext is None or ext.side is None else SIDE_WORDS[ext.side]
+
+
+def _convex(rho: FloatArray) -> FloatArray:
+    """ρ where convex, +inf elsewhere (for the smallest convex radius)."""
+    return np.where(rho > 0.0, rho, np.inf)
+
+
+def _concave(rho: FloatArray) -> FloatArray:
+    """−ρ where concave, +inf elsewhere (for the smallest concave radius)."""
+    return np.where(rho < 0.0, -rho, np.inf)
+
+
+def _undercut_quantity(cam: Cam) -> tuple[Quantity, float]:
+    """The quantity whose minimum decides undercut, and the value it must stay above.
+
+    Roller: the convex pitch-curve radius must exceed r_f (else the profile
+    loops). Flat face: the profile radius r_b + s + a must stay > 0 (else a cusp).
+    """
+    if cam.is_roller:
+        return (lambda phi, side: _convex(cam.pitch(phi, side=side).rho)), cam.roller_radius
+    return (lambda phi, side: cam.profile(phi, side=side).rho), 0.0
+
+
+def _bad_range(quantity: Quantity, limit: float, worst: Extreme, step: float) -> tuple[float, float]:
+    """The cam-angle range [rad] around ``worst`` where ``quantity < limit``, by root finding.
+
+    Used when the violation lies between samples or in a one-sided limit at a
+    joint, so that no sample is flagged.
+    """
+
+    def g(phi: float) -> float:
+        return float(quantity(np.array([phi]), "right")[0]) - limit
+
+    def root(inside: float, outside: float) -> float:
+        if g(outside) < 0.0:
+            return outside
+        return float(brentq(g, min(inside, outside), max(inside, outside), xtol=1e-12))
+
+    centre = worst.phi
+    lo = centre if worst.side == "right" else root(centre - 1e-12, centre - 2.0 * step)
+    hi = centre if worst.side == "left" else root(centre + 1e-12, centre + 2.0 * step)
+    return float(np.mod(lo, TWO_PI)), float(np.mod(hi, TWO_PI)) if hi < TWO_PI else TWO_PI
+
+
 def analyse_geometry(
     cam: Cam, *, max_pressure_angle: float, face_width: float | None = None, step: float | None = None
 ) -> GeometryAnalysis:
-    """Sample the cam and check its limits.
+    """Sample the cam and check its limits at true extremes.
 
     Parameters
     ----------
@@ -97,42 +155,66 @@ def analyse_geometry(
     face_width
         Flat-follower face width [mm] to check against the minimum, if given.
     step
-        Sampling step [rad]; default the cam's (0.1°). Breakpoints are always samples.
+        Sampling step [rad]; default the cam's (0.1°). Breakpoints are always
+        samples, and every extreme is refined on the exact curves between
+        samples and at both sides of every joint, so the reported extremes do
+        not depend on the step.
     """
     phi = cam.sample_phi(step)
+    h = float(np.max(np.diff(phi)))
+    joints = [bp.phi for bp in cam.program.breakpoints]
     motion = cam.motion(phi)
     pitch = cam.pitch(phi)
     profile = cam.profile(phi)
     alpha = cam.pressure_angle(phi)
     warnings: list[str] = []
 
-    over = np.abs(alpha) > max_pressure_angle
-    if over.any():
-        worst = float(np.abs(alpha).max())
+    alpha_max = maximum(
+        lambda p, side: np.abs(cam.pressure_angle(p, side=side)), phi, joints, values=np.abs(alpha)
+    )
+    radius = np.hypot(profile.point[:, 0], profile.point[:, 1])
+    radius_min, radius_max = extremes(
+        lambda p, side: np.hypot(*cam.profile(p, side=side).point.T), phi, joints, values=radius
+    )
+    convex_min = minimum(
+        lambda p, side: _convex(cam.profile(p, side=side).rho), phi, joints, values=_convex(profile.rho)
+    )
+    concave_min = minimum(
+        lambda p, side: _concave(cam.profile(p, side=side).rho), phi, joints, values=_concave(profile.rho)
+    )
+
+    if alpha_max.value > max_pressure_angle:
+        ranges = flagged_ranges(phi, np.abs(alpha) > max_pressure_angle)
+        where = format_ranges(ranges) if ranges else alpha_max.where()
         warnings.append(
-            f"pressure angle reaches {math.degrees(worst):.2f}° > limit "
-            f"{math.degrees(max_pressure_angle):g}° at {format_ranges(flagged_ranges(phi, over))}"
+            f"pressure angle reaches {math.degrees(alpha_max.value):.2f}° > limit "
+            f"{math.degrees(max_pressure_angle):g}° at {where}"
         )
 
-    if cam.is_roller:
-        bad = (pitch.rho > 0) & (pitch.rho < cam.roller_radius)
-        values = np.where(bad, pitch.rho, np.inf)
-        face_min = None
-    else:
-        bad = profile.rho <= 0
-        values = np.where(bad, profile.rho, np.inf)
-        reach = np.abs(cam.contact_offset(phi))
-        face_min = float(2.0 * reach.max())
+    face_min = None
+    if not cam.is_roller:
+        reach_min, reach_max = extremes(
+            lambda p, side: cam.contact_offset(p, side=side), phi, joints, values=cam.contact_offset(phi)
+        )
+        reach = max(abs(reach_min.value), abs(reach_max.value))
+        face_min = 2.0 * reach
         if face_width is not None and face_width < face_min:
             warnings.append(
                 f"follower.face_width {face_width:g} mm is below the minimum {face_min:.3f} mm "
-                f"(contact reaches {reach.max():.3f} mm off the follower axis)"
+                f"(contact reaches {reach:.3f} mm off the follower axis)"
             )
+
+    quantity, limit = _undercut_quantity(cam)
+    values = quantity(phi, "right")
+    worst = minimum(quantity, phi, joints, values=values)
     undercut = None
-    if bad.any():
-        k = int(np.argmin(values))
+    bad = values < limit if cam.is_roller else values <= limit
+    if worst.value < limit or (not cam.is_roller and worst.value <= limit):
+        ranges = flagged_ranges(phi, bad)
+        if not ranges:
+            ranges = [_bad_range(quantity, limit, worst, h)]
         undercut = Undercut(
-            ranges=tuple(flagged_ranges(phi, bad)), worst=float(values[k]), worst_angle=float(phi[k])
+            ranges=tuple(ranges), worst=worst.value, worst_angle=worst.phi, worst_side=worst.side
         )
     s = np.asarray(motion.s)
     readonly(phi)
@@ -147,6 +229,11 @@ def analyse_geometry(
         undercut=undercut,
         warnings=tuple(warnings),
         face_width_min=face_min,
+        pressure_angle_max=alpha_max,
+        profile_radius_min=radius_min,
+        profile_radius_max=radius_max,
+        curvature_radius_min=convex_min if math.isfinite(convex_min.value) else None,
+        concave_radius_min=concave_min if math.isfinite(concave_min.value) else None,
     )
 
 
@@ -160,14 +247,14 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
     if cam.is_roller:
         what = (
             f"undercut at {where}: the pitch curve's convex radius of curvature falls to "
-            f"{uc.worst:.3f} mm at {math.degrees(uc.worst_angle):.1f}°, below the roller radius "
+            f"{uc.worst:.3f} mm {uc.where()}, below the roller radius "
             f"{cam.roller_radius:g} mm, so the profile loops"
         )
         way_out = "or use a smaller roller"
     else:
         what = (
             f"cusp at {where}: the profile radius of curvature r_b + s + a falls to "
-            f"{uc.worst:.3f} mm at {math.degrees(uc.worst_angle):.1f}°"
+            f"{uc.worst:.3f} mm {uc.where()}"
         )
         way_out = "or use a gentler motion law"
     message = (

@@ -16,7 +16,7 @@ import numpy as np
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.design import Design, FollowerKind, FollowerSpec, Rotation
 from camcad.geometry.curves import CurveSample, curve_sample, rotate_to_cam
-from camcad.motion.program import Motion, MotionProgram
+from camcad.motion.program import Motion, MotionProgram, Side
 
 __all__ = ["Cam"]
 
@@ -44,14 +44,19 @@ class Cam:
     follower
         Follower kind, roller radius r_f [mm], offset e [mm].
     rotation
-        ``CCW`` (default) or ``CW`` (the mirror image about the y axis).
+        ``CCW`` (default) or ``CW``.
 
     Notes
     -----
     Cam frame: origin on the cam axis, x right, y up; at φ = 0 the follower
-    stands on +y. For a counter-clockwise cam the roller centre is
-    P = R(−φ)·(e, k + s) with k = √((r_b + r_f)² − e²)
-    (Quang & Hung 2015, eq. 2 with the erratum y_p = (k + s) cos φ − e sin φ).
+    stands on +y and its axis is the line x = e, whatever the rotation. For a
+    counter-clockwise cam the roller centre is P = R(−φ)·(e, k + s) with
+    k = √((r_b + r_f)² − e²) (Quang & Hung 2015, eq. 2 with the erratum
+    y_p = (k + s) cos φ − e sin φ). A clockwise cam is the mirror image, about
+    the y axis, of a counter-clockwise cam whose follower is at −e: its roller
+    centre is P = R(+φ)·(e, k + s). Everything is computed in the follower
+    frame of that counter-clockwise cam, with the eccentricity
+    :attr:`local_eccentricity`, and mirrored into the cam frame at the end.
     """
 
     program: MotionProgram
@@ -89,6 +94,11 @@ class Cam:
         return self.follower.offset
 
     @property
+    def local_eccentricity(self) -> float:
+        """e [mm] in the computing frame: e for a ccw cam, −e for a cw cam (its mirror image)."""
+        return self._sign * self.offset_e
+
+    @property
     def prime_k(self) -> float:
         """k [mm]: roller centre height at s = 0 along the follower axis (Quang & Hung 2015, eq. 2)."""
         if self.is_roller:
@@ -100,9 +110,9 @@ class Cam:
     def _sign(self) -> float:
         return 1.0 if self.rotation is Rotation.CCW else -1.0
 
-    def motion(self, phi: ArrayLike) -> Motion:
-        """The follower motion at cam angles φ [rad]."""
-        return self.program.evaluate(phi)
+    def motion(self, phi: ArrayLike, *, side: Side = "right") -> Motion:
+        """The follower motion at cam angles φ [rad]; ``side`` picks the one-sided limit at joints."""
+        return self.program.evaluate(phi, side=side)
 
     def sample_phi(self, step: float | None = None) -> FloatArray:
         """Cam angles in [0, 2π) at ``step`` [rad] (default: the design's) plus every breakpoint."""
@@ -111,7 +121,7 @@ class Cam:
     # -- curves -------------------------------------------------------------
 
     def _pitch_local(self, m: Motion) -> _Local:
-        e, k = self.offset_e, self.prime_k
+        e, k = self.local_eccentricity, self.prime_k
         ks = k + m.s
         return _Local(
             l0=np.column_stack((np.full_like(ks, e), ks)),
@@ -123,14 +133,14 @@ class Cam:
     def _to_cam(self, phi: FloatArray, local: FloatArray) -> FloatArray:
         return rotate_to_cam(phi, local, self._sign)
 
-    def pitch(self, phi: ArrayLike) -> CurveSample:
+    def pitch(self, phi: ArrayLike, *, side: Side = "right") -> CurveSample:
         """The pitch curve at cam angles φ [rad].
 
         For a roller follower it is the path of the roller centre; for a flat
         follower, the path of the face centre (the point of the face on the
-        follower axis).
+        follower axis). ``side`` picks the one-sided limit at joints.
         """
-        m = self.motion(phi)
+        m = self.motion(phi, side=side)
         loc = self._pitch_local(m)
         return curve_sample(
             m.phi,
@@ -140,13 +150,13 @@ class Cam:
             clockwise=self.rotation is Rotation.CCW,
         )
 
-    def _base_curve(self, phi: ArrayLike) -> tuple[CurveSample, FloatArray, FloatArray]:
+    def _base_curve(self, phi: ArrayLike, side: Side) -> tuple[CurveSample, FloatArray, FloatArray]:
         """The curve offsets are taken from, with its signed ρ and dρ/dφ.
 
         Roller: the pitch curve (the profile is its offset by −r_f).
         Flat: the profile itself, with ρ = r_b + s + a and dρ/dφ = v + j.
         """
-        m = self.motion(phi)
+        m = self.motion(phi, side=side)
         phi_a = m.phi
         clockwise = self.rotation is Rotation.CCW
         if self.is_roller:
@@ -192,7 +202,7 @@ class Cam:
         readonly(base.point, base.d1, base.d2, base.tangent, base.normal, base.rho)
         return base, rho, m.v + m.j
 
-    def offset(self, phi: ArrayLike, distance: float) -> CurveSample:
+    def offset(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
         """The profile offset outward by ``distance`` [mm] at cam angles φ [rad].
 
         ``distance = r`` is the centre path of a milling tool (or a roller) of
@@ -206,9 +216,9 @@ class Cam:
         the pitch curve offset by δ = −r_f (Quintero & Vanegas 2016, eq. 13;
         papers/README erratum to Quang & Hung 2015, eq. 3). Where 1 + δ/ρ < 0
         the offset loops (undercut or gouge); ``tangent`` and ``normal`` then
-        stay those of the base curve.
+        stay those of the base curve. ``side`` picks the one-sided limit at joints.
         """
-        base, rho, drho = self._base_curve(phi)
+        base, rho, drho = self._base_curve(phi, side)
         delta = distance - self.roller_radius
         if delta == 0.0:
             return base
@@ -230,28 +240,32 @@ class Cam:
         readonly(out.point, out.d1, out.d2, out.rho)
         return out
 
-    def profile(self, phi: ArrayLike) -> CurveSample:
-        """The cam profile (contact point C) at cam angles φ [rad]."""
-        return self.offset(phi, 0.0)
+    def profile(self, phi: ArrayLike, *, side: Side = "right") -> CurveSample:
+        """The cam profile (contact point C) at cam angles φ [rad]; ``side`` as in :meth:`offset`."""
+        return self.offset(phi, 0.0, side=side)
 
-    def pressure_angle(self, phi: ArrayLike) -> FloatArray:
+    def pressure_angle(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
         """Signed pressure angle α [rad] at cam angles φ [rad].
 
         Notes
         -----
         General form: the angle from the follower's direction of travel u to
         the common normal n at the contact, α = atan2(−n·u⊥, n·u) with
-        u = R(−φ)(0, 1), u⊥ = R(−φ)(1, 0). For an offset roller this is
-        tan α = (v − e)/(s + k) (Quang & Hung 2015, eq. 4); its magnitude is
+        u = R(−φ)(0, 1), u⊥ = R(−φ)(1, 0) in the computing (ccw) frame. For an
+        offset roller this is tan α = (v − e)/(s + k) (Quang & Hung 2015,
+        eq. 4), and for a clockwise cam, the mirror image of a ccw cam with
+        the follower at −e, tan α = (v + e)/(s + k). Its magnitude is
         arccos(R·n/|R|) for a radial follower (Quintero & Vanegas 2016,
-        eq. 14). A flat-faced follower has α ≡ 0.
+        eq. 14). α > 0 where the normal leans towards the side the cam
+        surface comes from (on a rise, for either rotation). A flat-faced
+        follower has α ≡ 0. ``side`` picks the one-sided limit at joints.
         """
         if not self.is_roller:
-            m = self.motion(phi)
+            m = self.motion(phi, side=side)
             out = np.zeros_like(m.s)
             readonly(out)
             return out
-        p = self.pitch(phi)
+        p = self.pitch(phi, side=side)
         n = p.normal
         ones, zeros = np.ones(len(p.phi)), np.zeros(len(p.phi))
         u = self._to_cam(p.phi, np.column_stack((zeros, ones)))
@@ -262,18 +276,20 @@ class Cam:
         readonly(out)
         return out
 
-    def contact_offset(self, phi: ArrayLike) -> FloatArray:
-        """Lateral distance of the contact from the follower axis [mm], along +x of the follower frame.
+    def contact_offset(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
+        """Lateral distance of the contact from the follower axis [mm], along +x of the computing frame.
 
-        For a flat face it equals v = ds/dφ minus the offset e (Hren et al.,
-        eq. 27 with the papers/README reading r_m = |ds/dφ|); for a roller it
-        is the roller radius times sin α.
+        For a flat face it equals v = ds/dφ minus the eccentricity (Hren et
+        al., eq. 27 with the papers/README reading r_m = |ds/dφ|); for a
+        roller it is the roller radius times sin α. For a clockwise cam the
+        computing frame is the mirror image of the machine (see the class
+        notes), so the machine sees the contact at −contact_offset.
         """
-        m = self.motion(phi)
+        m = self.motion(phi, side=side)
         if not self.is_roller:
-            out = m.v - self.offset_e
+            out = m.v - self.local_eccentricity
         else:
-            out = self.roller_radius * np.sin(self.pressure_angle(phi))
+            out = self.roller_radius * np.sin(self.pressure_angle(phi, side=side))
         out = np.asarray(out, dtype=float)
         readonly(out)
         return out

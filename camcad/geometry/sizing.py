@@ -7,7 +7,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from camcad._typing import FloatArray
 from camcad.errors import DesignError
+from camcad.extremes import Extreme, Side, maximum, minimum
 from camcad.geometry.cam import Cam
 
 __all__ = ["SizingResult", "feasible_margins", "min_base_radius"]
@@ -21,37 +23,45 @@ class SizingResult:
     """The smallest base radius and what limits it.
 
     ``limit`` is ``"pressure angle"`` or ``"curvature"``; ``angle`` [rad] is
-    the cam angle where that limit is reached at ``base_radius`` [mm].
+    the cam angle where that limit is reached at ``base_radius`` [mm], with
+    ``side`` when it is reached as a one-sided limit at a joint.
     """
 
     base_radius: float
     limit: str
     angle: float
+    side: Side | None  # the limit is reached just before ("left") or after ("right") a joint
     pressure_angle_max: float  # rad, at base_radius
     curvature_radius_min: float  # mm, smallest convex profile radius at base_radius
 
 
 def feasible_margins(
     cam: Cam, phi: np.ndarray, *, max_pressure_angle: float, min_curvature_radius: float
-) -> tuple[float, float, int, int]:
-    """Margins of both limits (≥ 0 is met) and the cam-angle index of each worst case.
+) -> tuple[float, float, Extreme, Extreme]:
+    """Margins of both limits (≥ 0 is met) at their true extremes, and those extremes.
 
-    Returns ``(pressure_margin [rad], curvature_margin [mm], i_pressure, i_curvature)``.
+    Returns ``(pressure_margin [rad], curvature_margin [mm], worst |α|, worst ρ)``.
     The curvature margin is the smallest convex profile radius minus the
     required one; a roller whose pitch curve is sharper than the roller (an
-    undercut) has a negative margin.
+    undercut) has a negative margin. Both extremes are true extremes over the
+    turn (:func:`camcad.extremes.extremes`): refined between the samples
+    ``phi`` [rad] and taken at both sides of every joint.
     """
-    alpha = np.abs(cam.pressure_angle(phi))
-    i_alpha = int(np.argmax(alpha))
-    if cam.is_roller:
-        rho_pitch = cam.pitch(phi).rho
-        convex = rho_pitch > 0
-        rho_profile = np.where(convex, rho_pitch - cam.roller_radius, np.inf)
-    else:
-        rho_profile = cam.profile(phi).rho
-    i_rho = int(np.argmin(rho_profile))
-    margin_rho = float(rho_profile[i_rho]) - min_curvature_radius
-    return max_pressure_angle - float(alpha[i_alpha]), margin_rho, i_alpha, i_rho
+    joints = [bp.phi for bp in cam.program.breakpoints]
+
+    def alpha(p: FloatArray, side: Side) -> FloatArray:
+        return np.abs(cam.pressure_angle(p, side=side))
+
+    def rho(p: FloatArray, side: Side) -> FloatArray:
+        if cam.is_roller:
+            rho_pitch = cam.pitch(p, side=side).rho
+            return np.where(rho_pitch > 0, rho_pitch - cam.roller_radius, np.inf)
+        return cam.profile(p, side=side).rho
+
+    worst_alpha = maximum(alpha, phi, joints)
+    worst_rho = minimum(rho, phi, joints)
+    margin_rho = worst_rho.value - min_curvature_radius
+    return max_pressure_angle - worst_alpha.value, margin_rho, worst_alpha, worst_rho
 
 
 def _ok(cam: Cam, phi: np.ndarray, alpha_max: float, rho_min: float) -> bool:
@@ -69,7 +79,7 @@ def min_base_radius(
     min_curvature_radius: float = 0.0,
     step: float | None = None,
 ) -> SizingResult:
-    """Search the smallest base radius [mm] meeting both limits on the sample grid.
+    """Search the smallest base radius [mm] meeting both limits at their true extremes.
 
     Parameters
     ----------
@@ -87,8 +97,12 @@ def min_base_radius(
     -----
     Both margins grow with the base radius (|tan α| = |v − e|/(s + k) and the
     pitch radius of curvature both increase with k), so the feasible set is a
-    half-line: the search doubles an upper bracket, then bisects to 1e-7 mm.
-    The result is verified feasible before it is returned.
+    half-line: the search doubles an upper bracket, then narrows it to 1e-7 mm
+    by regula falsi (Illinois) on the relative margin.
+    Each trial checks the true extremes (one-sided limits at joints
+    included), so a profile that loops only in the last fraction of a degree
+    before a joint is not passed. The result is verified feasible before it
+    is returned.
     """
     phi = cam.sample_phi(step)
     lo = max(abs(cam.offset_e) - cam.roller_radius, 0.0) + _RADIUS_TOL_MM
@@ -109,23 +123,41 @@ def min_base_radius(
             )
     if _ok(at(lo), phi, max_pressure_angle, min_curvature_radius):
         hi = lo
+
+    def trial(radius: float) -> tuple[bool, float]:
+        """Whether ``radius`` meets both limits, and its smaller relative margin."""
+        m_a, m_r, _, _ = feasible_margins(
+            at(radius), phi, max_pressure_angle=max_pressure_angle, min_curvature_radius=min_curvature_radius
+        )
+        ok = m_a >= 0.0 and (m_r > 0.0 if min_curvature_radius == 0.0 else m_r >= 0.0)  # ρ = 0: a cusp
+        return ok, min(m_a / max(max_pressure_angle, 1e-12), m_r / max(min_curvature_radius, 1.0))
+
+    # Illinois regula falsi on the (continuous, increasing) relative margin, keeping the
+    # bracket lo infeasible < hi feasible; a bisection step wherever the secant is unusable.
+    f_lo, f_hi, kept = trial(lo)[1], trial(hi)[1], 0
     while hi - lo > _RADIUS_TOL_MM:
-        mid = 0.5 * (lo + hi)
-        if _ok(at(mid), phi, max_pressure_angle, min_curvature_radius):
-            hi = mid
+        x = hi - f_hi * (hi - lo) / (f_hi - f_lo) if math.isfinite(f_lo) and f_hi != f_lo else math.nan
+        if abs(kept) > 2 or not lo + 0.25 * _RADIUS_TOL_MM < x < hi - 0.25 * _RADIUS_TOL_MM:
+            x, kept = 0.5 * (lo + hi), 0  # the secant creeps from one side or is unusable: bisect
+        ok, f_x = trial(x)
+        if ok:
+            hi, f_hi = x, f_x
+            f_lo, kept = (0.5 * f_lo if kept < 0 else f_lo), min(kept, 0) - 1
         else:
-            lo = mid
+            lo, f_lo = x, f_x
+            f_hi, kept = (0.5 * f_hi if kept > 0 else f_hi), max(kept, 0) + 1
     best = at(hi)
-    m_alpha, m_rho, i_alpha, i_rho = feasible_margins(
+    m_alpha, m_rho, worst_alpha, worst_rho = feasible_margins(
         best, phi, max_pressure_angle=max_pressure_angle, min_curvature_radius=min_curvature_radius
     )
     # the binding limit is the one with the smaller relative margin
     alpha_binding = m_alpha / max(max_pressure_angle, 1e-12) < m_rho / max(min_curvature_radius, 1.0)
-    limit, i = ("pressure angle", i_alpha) if alpha_binding else ("curvature", i_rho)
+    limit, worst = ("pressure angle", worst_alpha) if alpha_binding else ("curvature", worst_rho)
     return SizingResult(
         base_radius=hi,
         limit=limit,
-        angle=float(phi[i]),
+        angle=worst.phi,
+        side=worst.side,
         pressure_angle_max=max_pressure_angle - m_alpha,
         curvature_radius_min=m_rho + min_curvature_radius,
     )

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -22,14 +23,16 @@ __all__ = [
     "Joint",
     "Motion",
     "MotionProgram",
+    "Side",
     "TimeMotion",
 ]
 
 TWO_PI = 2.0 * math.pi
+Side = Literal["left", "right"]
+"""Which one-sided limit to take at a joint: ``"left"`` (just before), ``"right"`` (just after)."""
+_SNAP = 1e-12  # a normalised x this close to a law's breakpoint is that breakpoint
 # A jump smaller than this (relative to the derivative's scale) is continuity.
 _JUMP_RTOL = 1e-9
-_INTERIOR_EPS = 1e-12  # x-distance of the one-sided limits at a law's own breakpoints
-_INTERIOR_SLACK = 1e-6
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -163,37 +166,55 @@ class MotionProgram:
         return np.searchsorted(edges, phi, side="right")
 
     def _evaluate_segment(
-        self, index: int, x: FloatArray
+        self, index: int, x: FloatArray, side: Side = "right"
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """s, v, a, j of segment ``index`` at normalised x ∈ [0, 1]."""
+        """s, v, a, j of segment ``index`` at normalised x ∈ [0, 1].
+
+        At a breakpoint inside the law (where it switches formula) the
+        one-sided limit of ``side`` is taken: x moves one ulp to that side, so
+        the formula of that side is evaluated there, exact to round-off.
+        """
         seg = self.segments[index]
         base = self.base_s[index]
         if seg.kind is SegmentKind.DWELL or seg.law is None:
             zero = np.zeros_like(x)
             return zero + base, zero, zero, zero
+        if seg.law.breakpoints:
+            toward = 0.0 if side == "left" else 1.0
+            for xb in seg.law.breakpoints:
+                x = np.where(np.abs(x - xb) <= _SNAP, np.nextafter(xb, toward), x)
         y, y1, y2, y3 = seg.law.evaluate(x)
         h = seg.lift if seg.kind is SegmentKind.RISE else -seg.lift
         beta = seg.span
         # chain rule: x = (φ − φ0)/β, so d^k/dφ^k = β^-k d^k/dx^k
         return base + h * y, h * y1 / beta, h * y2 / beta**2, h * y3 / beta**3
 
-    def evaluate(self, phi: ArrayLike) -> Motion:
+    def evaluate(self, phi: ArrayLike, *, side: Side = "right") -> Motion:
         """Displacement and its φ-derivatives at any cam angles.
 
         Parameters
         ----------
         phi
             Cam angles [rad], any shape; wrapped into [0, 2π).
+        side
+            At a joint (a segment joint or a breakpoint inside a law) the
+            one-sided limit to return: ``"right"`` (the default, the motion
+            just after the joint) or ``"left"`` (just before it; at 0° that is
+            the end of the last segment). Elsewhere both give the same values.
 
         Returns
         -------
         Motion
-            Flattened (n,) arrays. At a joint the segment that starts there is
-            used (right-continuous).
+            Flattened (n,) arrays.
         """
         phi_in = np.asarray(phi, dtype=float).ravel()
         wrapped = np.mod(phi_in, TWO_PI)
-        index = self._segment_of(wrapped)
+        if side == "left":
+            wrapped = np.where(wrapped == 0.0, TWO_PI, wrapped)  # the end of the last segment
+            edges = np.asarray(self.starts[1:])
+            index = np.searchsorted(edges, wrapped, side="left")
+        else:
+            index = self._segment_of(wrapped)
         s = np.zeros_like(wrapped)
         v, a, j = np.zeros_like(s), np.zeros_like(s), np.zeros_like(s)
         for k, seg in enumerate(self.segments):
@@ -201,7 +222,7 @@ class MotionProgram:
             if not mask.any():
                 continue
             x = np.clip((wrapped[mask] - self.starts[k]) / seg.span, 0.0, 1.0)
-            s[mask], v[mask], a[mask], j[mask] = self._evaluate_segment(k, x)
+            s[mask], v[mask], a[mask], j[mask] = self._evaluate_segment(k, x, side)
         out = Motion(phi=phi_in.copy(), s=s, v=v, a=a, j=j)
         readonly(out.phi, out.s, out.v, out.a, out.j)
         return out
@@ -218,19 +239,16 @@ class MotionProgram:
         for k, seg in enumerate(self.segments):
             places.append((self.starts[k], (k - 1) % n, k, 1.0, 0.0, False))
             for x in seg.law.breakpoints if seg.law is not None else ():
-                eps = _INTERIOR_EPS
-                places.append((self.starts[k] + x * seg.span, k, k, x - eps, x + eps, True))
+                places.append((self.starts[k] + x * seg.span, k, k, x, x, True))
         out = []
         for phi, left_k, right_k, x_left, x_right, internal in places:
-            left = self._evaluate_segment(left_k, np.array([x_left]))
-            right = self._evaluate_segment(right_k, np.array([x_right]))
+            left = self._evaluate_segment(left_k, np.array([x_left]), "left")
+            right = self._evaluate_segment(right_k, np.array([x_right]), "right")
             cleaned = []
             for order, (l_, r) in enumerate(zip(left[1:], right[1:], strict=True), start=1):
                 value = float(r[0] - l_[0])
                 ref = max(self._derivative_scale(left_k, order), self._derivative_scale(right_k, order))
-                # one-sided limits inside a law are taken ε away: allow for that slope
-                tol = (_JUMP_RTOL + (_INTERIOR_SLACK if internal else 0.0)) * ref
-                cleaned.append(0.0 if abs(value) <= tol else value)
+                cleaned.append(0.0 if abs(value) <= _JUMP_RTOL * ref else value)
             continuity = next((order for order, value in enumerate(cleaned) if value != 0.0), 3)
             out.append(
                 Joint(

@@ -16,18 +16,16 @@ from tests.dynamics.test_energy import paper_design
 from tests.dynamics.test_tappet import table1_design
 
 SUMMARY_KEYS = {
-    "torque_max_Nmm",
-    "torque_max_angle_deg",
-    "torque_min_Nmm",
-    "torque_min_angle_deg",
-    "contact_force_max_N",
-    "contact_force_min_N",
-    "jump",
-    "jump_range_deg",
-    "hertz_stress_max_MPa",
-    "hertz_stress_max_angle_deg",
-    "warnings",
-}
+    f"{name}_{suffix}"
+    for name, unit in (
+        ("torque_max", "Nmm"),
+        ("torque_min", "Nmm"),
+        ("contact_force_max", "N"),
+        ("contact_force_min", "N"),
+        ("hertz_stress_max", "MPa"),
+    )
+    for suffix in (unit, "angle_deg", "side")
+} | {"jump", "jump_range_deg", "min_preload_N", "speed_range_rpm", "warnings"}
 
 
 def analyse(design, step=None) -> DynamicsResult:

@@ -200,8 +200,9 @@ def test_small_base_radius_gives_undercut_with_a_radius_that_works():
     assert analyse_geometry(smaller, max_pressure_angle=math.radians(89)).undercut is not None
 
 
-def test_clockwise_rotation_is_the_mirror_image():
-    ccw = Cam.from_design(make_design(law="poly-345", offset=7.0))
+def test_clockwise_rotation_is_the_mirror_image_of_the_mirrored_follower():
+    """A cw cam with its follower at x = +e mirrors a ccw cam whose follower is at −e."""
+    ccw = Cam.from_design(make_design(law="poly-345", offset=-7.0))
     cw = Cam.from_design(make_design(law="poly-345", offset=7.0, rotation="cw"))
     phi = np.linspace(0, 2 * math.pi, 300, endpoint=False)
     a, b = ccw.profile(phi), cw.profile(phi)
