@@ -16,6 +16,7 @@ import numpy as np
 from camcad._version import __version__
 from camcad.design import Design
 from camcad.dynamics import DynamicsResult
+from camcad.extremes import SIDE_WORDS, maximum
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
 from camcad.motion.program import Motion
@@ -94,16 +95,19 @@ class Analysis:
 
 
 def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
-    """Peaks of |v|, |a|, |j| with their angles, the lift and the joint report."""
+    """True peaks of |v|, |a|, |j| with their angles (one-sided at joints), the lift and the joint report."""
     out: dict[str, Any] = {"lift_mm": cam.program.lift}
-    for key, unit, values in (
-        ("v", "mm_per_rad", motion.v),
-        ("a", "mm_per_rad2", motion.a),
-        ("j", "mm_per_rad3", motion.j),
-    ):
-        i = int(np.argmax(np.abs(values)))
-        out[f"{key}_max_abs_{unit}"] = float(abs(values[i]))
-        out[f"{key}_max_abs_angle_deg"] = math.degrees(float(motion.phi[i]))
+    joints = [bp.phi for bp in cam.program.breakpoints]
+    for key, unit in (("v", "mm_per_rad"), ("a", "mm_per_rad2"), ("j", "mm_per_rad3")):
+        peak = maximum(
+            lambda p, side, key=key: np.abs(getattr(cam.motion(p, side=side), key)),
+            motion.phi,
+            joints,
+            values=np.abs(getattr(motion, key)),
+        )
+        out[f"{key}_max_abs_{unit}"] = peak.value
+        out[f"{key}_max_abs_angle_deg"] = peak.angle_deg
+        out[f"{key}_max_abs_side"] = None if peak.side is None else SIDE_WORDS[peak.side]
     out["joints"] = [
         {
             "angle_deg": math.degrees(j.phi),
