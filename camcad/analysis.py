@@ -17,6 +17,7 @@ from camcad._version import __version__
 from camcad.design import Design
 from camcad.dynamics import DynamicsResult
 from camcad.extremes import SIDE_WORDS, maximum
+from camcad.findings import Finding
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
 from camcad.motion.program import Motion
@@ -54,27 +55,20 @@ class Analysis:
     timings: dict[str, float] = field(default_factory=dict)
 
     @property
+    def findings(self) -> tuple[Finding, ...]:
+        """Every broken limit of every stage, hard ones first (see :mod:`camcad.findings`)."""
+        found = (*self.geometry.findings, *self.dynamics.findings)
+        return tuple(sorted(found, key=lambda f: not f.hard))
+
+    @property
     def warnings(self) -> list[str]:
-        """Every non-fatal finding of every stage."""
-        out = list(self.geometry.warnings)
-        out += list(self.dynamics.summary().get("warnings", []))
-        return out
+        """Every non-fatal message of every stage: soft findings and notes."""
+        return [*self.geometry.warnings, *self.dynamics.warnings]
 
     @property
     def violations(self) -> list[str]:
-        """Design limits that are broken (``camcad check`` exits 3 when any)."""
-        out = []
-        if self.geometry.undercut is not None:
-            out.append("undercut")
-        if any(w.startswith("pressure angle") for w in self.geometry.warnings):
-            out.append("pressure angle")
-        dyn = self.dynamics.summary()
-        if dyn.get("jump"):
-            out.append("jump")
-        if dyn.get("hertz_stress_max_MPa") is not None and self.design.dynamics.allowable_stress is not None:
-            if dyn["hertz_stress_max_MPa"] > self.design.dynamics.allowable_stress:
-                out.append("contact stress")
-        return out
+        """The kinds of the broken limits, hard and soft (``camcad check`` exits 3 when any)."""
+        return list(dict.fromkeys(f.kind for f in self.findings))
 
     def summary(self) -> dict[str, Any]:
         """The content of ``summary.json``."""
@@ -91,6 +85,7 @@ class Analysis:
             out["gcode"] = self.toolpath.summary()
         out["warnings"] = self.warnings
         out["violations"] = self.violations
+        out["findings"] = [f.summary() for f in self.findings]
         return out
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 from tests.conftest import ROOT
 
 LAYERS = {
-    "_typing": 0, "_version": 0, "errors": 0, "angles": 0, "extremes": 0,
+    "_typing": 0, "_version": 0, "errors": 0, "angles": 0, "extremes": 0, "findings": 0,
     "motion": 1, "design": 1,
     "geometry": 2,
     "dynamics": 3, "fit": 3,

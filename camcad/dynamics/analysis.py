@@ -23,6 +23,7 @@ from camcad.dynamics.results import DynamicsResult
 from camcad.dynamics.spring import spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, tappet_forces
 from camcad.extremes import Extreme, Kind, Quantity, Side, extremes
+from camcad.findings import Finding, Severity
 
 if TYPE_CHECKING:
     from camcad.design import Design
@@ -258,24 +259,48 @@ def analyse_dynamics(
     runs = loss_runs(motion.phi, sampled.force < margin)
     if not runs and force_min.value < margin:  # lost only between samples or just before/after a joint
         runs = ((force_min.phi % TWO_PI, force_min.phi % TWO_PI),)
+    findings: list[Finding] = []
     if runs:
-        warnings.insert(
-            0,
-            _jump_warning(
-                runs=runs,
-                margin=margin,
-                omega=omega,
-                preload=preload,
-                deflection=deflection,
-                speeds=speeds,
-                worst=force_min,
-            ),
+        message = _jump_warning(
+            runs=runs,
+            margin=margin,
+            omega=omega,
+            preload=preload,
+            deflection=deflection,
+            speeds=speeds,
+            worst=force_min,
+        )
+        warnings.insert(0, message)
+        findings.append(
+            Finding(
+                kind="jump",
+                severity=Severity.SOFT,
+                field="dynamics.spring_preload",
+                message=message,
+                angle=force_min.phi,
+                value=force_min.value,
+                limit=margin,
+                unit="N",
+            )
         )
     if dyn.allowable_stress is not None and stress_max.value > dyn.allowable_stress:
-        warnings.append(
+        message = (
             f"Hertz contact stress reaches {stress_max.value:.1f} MPa {stress_max.where()}, above the "
             f"allowable {dyn.allowable_stress:g} MPa: widen the contact, enlarge the roller or the "
             "base circle, or lower the spring load"
+        )
+        warnings.append(message)
+        findings.append(
+            Finding(
+                kind="contact stress",
+                severity=Severity.SOFT,
+                field="dynamics.allowable_stress",
+                message=message,
+                angle=stress_max.phi,
+                value=stress_max.value,
+                limit=dyn.allowable_stress,
+                unit="MPa",
+            )
         )
     torque = np.asarray(sampled.torque, dtype=float)
     readonly(phi, torque)
@@ -295,6 +320,7 @@ def analyse_dynamics(
         speed_range_rpm=speeds,
         allowable_stress=dyn.allowable_stress,
         warnings=tuple(warnings),
+        findings=tuple(findings),
         contact_force_min=force_min,
         contact_force_max=force_max,
         torque_min=torque_min,

@@ -18,6 +18,7 @@ from camcad.design import DynamicsModel
 from camcad.dynamics.jump import covering_arc
 from camcad.errors import JumpError
 from camcad.extremes import SIDE_WORDS, Extreme
+from camcad.findings import Finding
 
 __all__ = ["CSV_HEADER", "DynamicsResult"]
 
@@ -70,7 +71,10 @@ class DynamicsResult:
     allowable_stress
         ``[dynamics].allowable_stress`` [MPa] or ``None``.
     warnings
-        Findings for the report, one sentence each.
+        Every message for the report, one sentence each: the findings' and
+        notes on the model's validity (guide forces changing side).
+    findings
+        The broken limits (jump, contact stress) as typed findings.
     contact_force_min, contact_force_max, torque_min, torque_max, hertz_stress_max
         True extremes over the turn (one-sided limits at joints included), when
         the analysis had the exact cam; else ``None`` and the summary falls back
@@ -92,6 +96,7 @@ class DynamicsResult:
     speed_range_rpm: tuple[float, float] | None = None
     allowable_stress: float | None = None
     warnings: tuple[str, ...] = ()
+    findings: tuple[Finding, ...] = ()
     contact_force_min: Extreme | None = None
     contact_force_max: Extreme | None = None
     torque_min: Extreme | None = None

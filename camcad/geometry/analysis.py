@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -13,6 +13,7 @@ from camcad._typing import FloatArray, readonly
 from camcad.angles import flagged_ranges, format_ranges
 from camcad.errors import UndercutError
 from camcad.extremes import SIDE_WORDS, Extreme, Quantity, Side, extremes, maximum, minimum
+from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.sizing import min_base_radius
@@ -60,13 +61,18 @@ class GeometryAnalysis:
     pressure_angle: FloatArray
     max_pressure_angle: float  # rad, the design limit
     undercut: Undercut | None
-    warnings: tuple[str, ...]
-    face_width_min: float | None  # mm, flat follower only: twice the largest contact excursion
+    findings: tuple[Finding, ...]
+    face_width_min: float | None  # mm, flat follower only: 2 × (largest contact excursion + margin)
     pressure_angle_max: Extreme  # of |α| [rad]
     profile_radius_min: Extreme  # polar radius of the contact point [mm]
     profile_radius_max: Extreme
     curvature_radius_min: Extreme | None  # smallest convex profile radius [mm]; None if none convex
     concave_radius_min: Extreme | None  # smallest concave profile radius [mm] (positive); None if none
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """The messages of the soft findings (pressure angle)."""
+        return tuple(f.message for f in self.findings if not f.hard)
 
     @property
     def profile_radius(self) -> FloatArray:
@@ -142,7 +148,13 @@ def _bad_range(quantity: Quantity, limit: float, worst: Extreme, step: float) ->
 
 
 def analyse_geometry(
-    cam: Cam, *, max_pressure_angle: float, face_width: float | None = None, step: float | None = None
+    cam: Cam,
+    *,
+    max_pressure_angle: float,
+    face_width: float | None = None,
+    face_margin: float = 1.0,
+    min_curvature_radius: float = 0.0,
+    step: float | None = None,
 ) -> GeometryAnalysis:
     """Sample the cam and check its limits at true extremes.
 
@@ -151,9 +163,15 @@ def analyse_geometry(
     cam
         The cam.
     max_pressure_angle
-        Design limit on |α| [rad]; exceeding it is a warning, not an error.
+        Design limit on |α| [rad]; exceeding it is a soft finding.
     face_width
-        Flat-follower face width [mm] to check against the minimum, if given.
+        Flat-follower face width [mm], centred on the follower axis. It must
+        cover the contact point's whole travel (r_m = |ds/dφ − e|, Hren et al.
+        eq. 27) plus ``face_margin`` on each side, or it is a hard finding.
+    face_margin
+        Margin [mm] beyond the contact's travel at each edge of the face.
+    min_curvature_radius
+        Smallest convex profile radius [mm] the undercut advice sizes for.
     step
         Sampling step [rad]; default the cam's (0.1°). Breakpoints are always
         samples, and every extreme is refined on the exact curves between
@@ -167,7 +185,7 @@ def analyse_geometry(
     pitch = cam.pitch(phi)
     profile = cam.profile(phi)
     alpha = cam.pressure_angle(phi)
-    warnings: list[str] = []
+    findings: list[Finding] = []
 
     alpha_max = maximum(
         lambda p, side: np.abs(cam.pressure_angle(p, side=side)), phi, joints, values=np.abs(alpha)
@@ -186,9 +204,20 @@ def analyse_geometry(
     if alpha_max.value > max_pressure_angle:
         ranges = flagged_ranges(phi, np.abs(alpha) > max_pressure_angle)
         where = format_ranges(ranges) if ranges else alpha_max.where()
-        warnings.append(
-            f"pressure angle reaches {math.degrees(alpha_max.value):.2f}° > limit "
-            f"{math.degrees(max_pressure_angle):g}° at {where}"
+        findings.append(
+            Finding(
+                kind="pressure angle",
+                severity=Severity.SOFT,
+                field="cam.max_pressure_angle",
+                message=(
+                    f"pressure angle reaches {math.degrees(alpha_max.value):.2f}° > limit "
+                    f"{math.degrees(max_pressure_angle):g}° at {where}"
+                ),
+                angle=alpha_max.phi,
+                value=math.degrees(alpha_max.value),
+                limit=math.degrees(max_pressure_angle),
+                unit="deg",
+            )
         )
 
     face_min = None
@@ -196,12 +225,25 @@ def analyse_geometry(
         reach_min, reach_max = extremes(
             lambda p, side: cam.contact_offset(p, side=side), phi, joints, values=cam.contact_offset(phi)
         )
-        reach = max(abs(reach_min.value), abs(reach_max.value))
-        face_min = 2.0 * reach
+        far = reach_max if abs(reach_max.value) >= abs(reach_min.value) else reach_min
+        reach = abs(far.value)
+        face_min = 2.0 * (reach + face_margin)
         if face_width is not None and face_width < face_min:
-            warnings.append(
-                f"follower.face_width {face_width:g} mm is below the minimum {face_min:.3f} mm "
-                f"(contact reaches {reach:.3f} mm off the follower axis)"
+            findings.append(
+                Finding(
+                    kind="face width",
+                    severity=Severity.HARD,
+                    field="follower.face_width",
+                    message=(
+                        f"follower.face_width: {face_width:g} mm does not cover the contact, which travels "
+                        f"{reach:.3f} mm off the follower axis {far.where()}; with face_margin "
+                        f"{face_margin:g} mm each side use face_width ≥ {_up(face_min):.2f} mm"
+                    ),
+                    angle=far.phi,
+                    value=face_width,
+                    limit=face_min,
+                    unit="mm",
+                )
             )
 
     quantity, limit = _undercut_quantity(cam)
@@ -216,9 +258,10 @@ def analyse_geometry(
         undercut = Undercut(
             ranges=tuple(ranges), worst=worst.value, worst_angle=worst.phi, worst_side=worst.side
         )
+    findings += _velocity_jumps(cam)
     s = np.asarray(motion.s)
     readonly(phi)
-    return GeometryAnalysis(
+    analysis = GeometryAnalysis(
         cam=cam,
         phi=phi,
         s=s,
@@ -227,7 +270,7 @@ def analyse_geometry(
         pressure_angle=alpha,
         max_pressure_angle=max_pressure_angle,
         undercut=undercut,
-        warnings=tuple(warnings),
+        findings=tuple(findings),
         face_width_min=face_min,
         pressure_angle_max=alpha_max,
         profile_radius_min=radius_min,
@@ -235,6 +278,61 @@ def analyse_geometry(
         curvature_radius_min=convex_min if math.isfinite(convex_min.value) else None,
         concave_radius_min=concave_min if math.isfinite(concave_min.value) else None,
     )
+    if undercut is None:
+        return analysis
+    err = undercut_error(analysis, min_curvature_radius=min_curvature_radius)
+    found = Finding(
+        kind="undercut" if cam.is_roller else "cusp",
+        severity=Severity.HARD,
+        field="cam.base_radius",
+        message=str(err),
+        angle=undercut.worst_angle,
+        value=undercut.worst,
+        limit=limit,
+        unit="mm",
+    )
+    return replace(analysis, findings=(found, *analysis.findings))
+
+
+def _up(value: float) -> float:
+    """Round up to the advice resolution (0.01 mm): advice always errs to the safe side."""
+    return math.ceil(value / _SUGGEST_ROUND_MM) * _SUGGEST_ROUND_MM
+
+
+def _velocity_jumps(cam: Cam) -> list[Finding]:
+    """A hard finding for every joint where the velocity jumps (a corner in the pitch curve).
+
+    ds/dφ jumping means an infinite follower acceleration (an impulse) and a
+    profile with a corner that no follower can track; the segment whose own
+    end velocity is not zero is named (a constant-velocity segment between
+    rests, typically).
+    """
+    out = []
+    for joint in cam.program.joints():
+        if joint.continuity > 0:
+            continue
+        left = float(cam.motion(np.array([joint.phi]), side="left").v[0])
+        k = (joint.index - 1) % len(cam.program.segments) if left != 0.0 else joint.index
+        law = cam.program.segments[k].law
+        name = law.name if law is not None else "dwell"
+        out.append(
+            Finding(
+                kind="velocity jump",
+                severity=Severity.HARD,
+                field=f"motion[{k}].law",
+                message=(
+                    f"motion[{k}].law: {name!r} makes the follower velocity jump by "
+                    f"{joint.dv:+.4g} mm/rad at {math.degrees(joint.phi):.1f}°, an infinite acceleration "
+                    "and a corner in the profile; use a law that starts and ends at rest "
+                    "('cycloidal', 'modified-trapezoid', 'modified-sine', 'poly-345')"
+                ),
+                angle=joint.phi,
+                value=joint.dv,
+                limit=0.0,
+                unit="mm/rad",
+            )
+        )
+    return out
 
 
 def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 0.0) -> UndercutError:

@@ -166,14 +166,23 @@ def test_flat_follower_contact_offset_equals_pseudo_velocity():
     assert_allclose(cam.profile(phi).rho, 50.0 + m.s + m.a, atol=1e-12)
 
 
-def test_hren_cam_has_no_cusp_and_reports_its_face_width():
+def test_hren_cam_has_no_cusp_and_a_narrow_face_is_a_hard_limit():
+    """Issue 11.4: the face must cover r_m = |ds/dφ| (003 eq. 27) plus face_margin each side."""
     design = load_design(ROOT / "samples" / "hren_tappet.toml")
     cam = Cam.from_design(design)
-    geo = analyse_geometry(cam, max_pressure_angle=design.cam.max_pressure_angle, face_width=1.0)
-    assert geo.undercut is None
-    v = cam.motion(geo.phi).v
-    assert geo.face_width_min == pytest.approx(2 * np.abs(v).max())
-    assert any("face_width" in w for w in geo.warnings)
+    v = cam.motion(np.linspace(0, 2 * math.pi, 1_000_000, endpoint=False)).v  # dense, independent
+    needed = 2 * (np.abs(v).max() + 1.5)
+    for width, hard in ((needed - 0.01, True), (needed + 0.01, False)):
+        geo = analyse_geometry(
+            cam, max_pressure_angle=design.cam.max_pressure_angle, face_width=width, face_margin=1.5
+        )
+        assert geo.undercut is None
+        assert geo.face_width_min == pytest.approx(needed, rel=1e-9)
+        found = [f for f in geo.findings if f.kind == "face width"]
+        assert bool(found) is hard
+        if hard:
+            assert found[0].hard and found[0].field == "follower.face_width"
+            assert f"face_width ≥ {math.ceil(needed * 100) / 100:.2f} mm" in found[0].message
 
 
 def test_small_base_radius_gives_undercut_with_a_radius_that_works():

@@ -1,0 +1,81 @@
+"""Typed findings: what an analysis found wrong with a design, made once, rendered everywhere.
+
+A :class:`Finding` is a broken limit with the design field that controls it,
+the value reached, the limit and one sentence for a person. Every stage
+reports its findings this way; the CLI, the report and ``summary.json`` render
+them, and one rule decides what stops a build:
+
+- **hard** limits make the part unusable (undercut, a flat face narrower than
+  the contact's travel, a velocity jump, gouge, an unreachable fit
+  tolerance): ``build`` stops with exit 3 and writes nothing;
+- **soft** limits are engineering judgement (pressure angle, contact stress,
+  follower jump): ``build`` writes the files and lists them as warnings, and
+  ``build --strict`` turns them into exit 3;
+- ``check`` exits 3 on either.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["Finding", "Severity"]
+
+
+class Severity(enum.Enum):
+    """Whether a broken limit stops a build (hard) or is a warning (soft)."""
+
+    HARD = "hard"
+    SOFT = "soft"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Finding:
+    """One broken design limit.
+
+    Attributes
+    ----------
+    kind
+        What broke, e.g. ``"undercut"``, ``"pressure angle"``.
+    severity
+        :class:`Severity`.
+    field
+        The design field that controls it, e.g. ``"cam.base_radius"``.
+    message
+        One sentence for a person: what, where, how much, and a way out.
+    angle
+        Cam angle where it is worst [rad], or ``None``.
+    value, limit
+        The value reached and the limit, in ``unit``, or ``None``.
+    unit
+        Unit of ``value`` and ``limit`` (``"mm"``, ``"deg"``, ``"N"``, ``"MPa"``).
+    """
+
+    kind: str
+    severity: Severity
+    field: str
+    message: str
+    angle: float | None = None
+    value: float | None = None
+    limit: float | None = None
+    unit: str = ""
+
+    @property
+    def hard(self) -> bool:
+        """Whether this finding stops a build."""
+        return self.severity is Severity.HARD
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready dict for ``summary.json`` (angle in degrees)."""
+        return {
+            "kind": self.kind,
+            "severity": self.severity.value,
+            "field": self.field,
+            "angle_deg": None if self.angle is None else round(math.degrees(self.angle), 6),
+            "value": self.value,
+            "limit": self.limit,
+            "unit": self.unit,
+            "message": self.message,
+        }
