@@ -1,0 +1,58 @@
+"""Translating flat-faced follower (the worked example of README "Adding a follower")."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from camcad.geometry.envelope import Guide, LineElement, PointElement
+from camcad.motion.program import Motion
+
+__all__ = ["TranslatingFlat"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TranslatingFlat:
+    """A flat face perpendicular to a slide along the machine's y axis, at x = e.
+
+    The face is the line y = r_b + s: normal angle θ = 90°, distance
+    p = r_b + s from the cam axis. Its eccentricity does not change the
+    profile, only where on the face the contact sits.
+    """
+
+    base_radius: float  # r_b [mm]
+    eccentricity: float = 0.0  # e [mm]: the slide's axis is the line x = e
+
+    @property
+    def roller_radius(self) -> float:
+        """0: a face, not a roller."""
+        return 0.0
+
+    @property
+    def guide(self) -> Guide:
+        """The slide: along +y."""
+        return Guide(axis=(0.0, 1.0))
+
+    def element(self, motion: Motion) -> LineElement:
+        """θ = π/2 (fixed), p = r_b + s with p′ = v, p″ = a, p‴ = j."""
+        zero = np.zeros_like(motion.s)
+        return LineElement(
+            theta=(zero + math.pi / 2.0, zero, zero, zero),
+            p=(self.base_radius + motion.s, motion.v, motion.a, motion.j),
+        )
+
+    def trace(self, motion: Motion) -> PointElement:
+        """The face centre (e, r_b + s): the point of the face on the slide's axis."""
+        zero = np.zeros_like(motion.s)
+        return PointElement(
+            m0=np.column_stack((zero + self.eccentricity, self.base_radius + motion.s)),
+            m1=np.column_stack((zero, motion.v)),
+            m2=np.column_stack((zero, motion.a)),
+            m3=np.column_stack((zero, motion.j)),
+        )
+
+    def describe(self) -> str:
+        """E.g. ``"translating flat face, e = 0 mm"``."""
+        return f"translating flat face, e = {self.eccentricity:g} mm"

@@ -1,0 +1,54 @@
+"""Translating roller follower, with eccentricity (offset)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from camcad.geometry.envelope import Guide, PointElement
+from camcad.motion.program import Motion
+
+__all__ = ["TranslatingRoller"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TranslatingRoller:
+    """A roller of radius r_f on a slide along the machine's y axis, at x = e.
+
+    At s = 0 the roller touches the base circle r_b, so its centre stands at
+    (e, k) with k = √((r_b + r_f)² − e²) (Quang & Hung 2015, eq. 2).
+    """
+
+    base_radius: float  # r_b [mm]
+    roller_radius: float  # r_f [mm]
+    eccentricity: float = 0.0  # e [mm]: the slide's axis is the line x = e
+
+    @property
+    def prime_k(self) -> float:
+        """k [mm]: roller-centre height at s = 0."""
+        return math.sqrt((self.base_radius + self.roller_radius) ** 2 - self.eccentricity**2)
+
+    @property
+    def guide(self) -> Guide:
+        """The slide: along +y."""
+        return Guide(axis=(0.0, 1.0))
+
+    def element(self, motion: Motion) -> PointElement:
+        """M = (e, k + s), M′ = (0, v), M″ = (0, a), M‴ = (0, j) [mm/radᵏ]."""
+        zero = np.zeros_like(motion.s)
+        return PointElement(
+            m0=np.column_stack((zero + self.eccentricity, self.prime_k + motion.s)),
+            m1=np.column_stack((zero, motion.v)),
+            m2=np.column_stack((zero, motion.a)),
+            m3=np.column_stack((zero, motion.j)),
+        )
+
+    def trace(self, motion: Motion) -> PointElement:
+        """The roller centre: the element itself."""
+        return self.element(motion)
+
+    def describe(self) -> str:
+        """E.g. ``"translating roller, r_f = 15 mm, e = 20 mm"``."""
+        return f"translating roller, r_f = {self.roller_radius:g} mm, e = {self.eccentricity:g} mm"
