@@ -640,7 +640,7 @@ def load_design(path: str | Path) -> Design:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a BOM at the start is accepted
     except FileNotFoundError:
         raise DesignError("", f"design file not found: {path}") from None
     except (OSError, UnicodeDecodeError) as err:

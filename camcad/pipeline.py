@@ -20,7 +20,7 @@ import numpy as np
 from camcad.analysis import Analysis, motion_summary
 from camcad.design import Design, load_design
 from camcad.dynamics import analyse_dynamics
-from camcad.errors import DesignError
+from camcad.errors import UsageError
 from camcad.export.atomic import staged_folder
 from camcad.export.records import write_csv, write_json, write_text
 from camcad.fit import fit_cam_profile
@@ -181,7 +181,7 @@ def _groups(only: Iterable[str] | None) -> set[str]:
     chosen = {aliases.get(g, g) for g in chosen}
     unknown = sorted(chosen - set(OUTPUT_GROUPS))
     if unknown:
-        raise DesignError("--only", f"unknown output {unknown[0]!r} (allowed: {', '.join(OUTPUT_GROUPS)})")
+        raise UsageError("--only", f"unknown output {unknown[0]!r} (allowed: {', '.join(OUTPUT_GROUPS)})")
     return chosen
 
 

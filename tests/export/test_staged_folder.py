@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from camcad.errors import DesignError
+from camcad.errors import OutputError
 from camcad.export.atomic import staged_folder
 
 
@@ -43,5 +43,5 @@ def test_a_new_folder_is_only_created_on_success(tmp_path):
     assert not out.exists()
     blocker = tmp_path / "file"
     blocker.write_text("x")
-    with pytest.raises(DesignError, match="--output"), staged_folder(blocker / "out"):
+    with pytest.raises(OutputError, match="--output"), staged_folder(blocker / "out"):
         pass
