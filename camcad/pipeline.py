@@ -194,9 +194,20 @@ def build(
 ) -> BuildResult:
     """Analyse the design and write its files into ``outdir`` all at once.
 
-    Everything is written into a temporary folder beside ``outdir`` first; the
+    Everything is written into a hidden folder beside ``outdir`` first; the
     files are moved into ``outdir`` only when every stage has succeeded, so a
-    failed build leaves ``outdir`` exactly as it was.
+    failed build leaves ``outdir`` exactly as it was and nothing beside it
+    (see :func:`camcad.export.atomic.staged_folder`).
+
+    Raises
+    ------
+    UsageError
+        When ``only`` names an unknown output (path ``--only``).
+    OutputError
+        When ``outdir`` or a file in it cannot be written (path ``--output``).
+    DesignLimitError
+        When the design breaks a hard limit (undercut, gouge, fit, a table the
+        profile cannot give).
     """
     groups = _groups(only)
     outdir = Path(outdir)

@@ -276,9 +276,10 @@ def _output_lock(outdir: Path) -> Iterator[None]:
     try:
         yield
     finally:
-        with suppress(OSError):
-            lock.unlink()
-        os.close(fd)
+        with _signals_held():
+            with suppress(OSError):
+                lock.unlink()
+            os.close(fd)
 
 
 def _check_destinations(outdir: Path, names: list[str]) -> None:
@@ -329,11 +330,16 @@ def _move_files(staging: Path, outdir: Path, names: list[str]) -> None:
 
 
 def _commit(staging: Path, outdir: Path) -> None:
-    """Move every file of ``staging`` into ``outdir`` all or nothing (see :func:`staged_folder`)."""
+    """Move every file of ``staging`` into ``outdir`` all or nothing (see :func:`staged_folder`).
+
+    Waiting for the lock can be interrupted; creating the parents, the move
+    and its rollback run with SIGINT, SIGTERM and SIGHUP held back.
+    """
     names = sorted(p.name for p in staging.iterdir())
-    created = _make_parents(outdir.parent)
+    with _signals_held():
+        created = _make_parents(outdir.parent)
     try:
-        with _output_lock(outdir):
+        with _output_lock(outdir), _signals_held():
             if not os.path.lexists(outdir):
                 try:
                     os.rename(staging, outdir)  # a new folder appears at once, complete
@@ -347,7 +353,8 @@ def _commit(staging: Path, outdir: Path) -> None:
             _check_destinations(outdir, names)
             _move_files(staging, outdir, names)
     except BaseException:
-        _remove_folders(created)
+        with _signals_held():
+            _remove_folders(created)
         raise
 
 
@@ -410,9 +417,7 @@ def staged_folder(outdir: str | os.PathLike[str]) -> Iterator[StagedFolder]:
             if mapped is err:
                 raise
             raise mapped from err
-        with _signals_held():
-            _commit(staging, target)
-            shutil.rmtree(staging, ignore_errors=True)
+        _commit(staging, target)
     finally:
         with _signals_held():
             shutil.rmtree(staging, ignore_errors=True)
