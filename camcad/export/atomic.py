@@ -140,6 +140,10 @@ def _existing_folder(outdir: Path) -> Path:
     OutputError
         When ``outdir`` or one of its parents is a file, or the folder is not writable.
     """
+    if "\0" in os.fspath(outdir):
+        raise OutputError(
+            repr(os.fspath(outdir)), "the path holds a NUL character", "choose another --output"
+        )
     if os.path.lexists(outdir) and not outdir.is_dir():
         raise OutputError(
             outdir, "it is a file, not a folder", "remove or rename it, or choose another --output"
@@ -313,7 +317,7 @@ def _move_files(staging: Path, outdir: Path, names: list[str]) -> None:
                 if had_old:
                     try:
                         os.link(dest, backup / name, follow_symlinks=False)
-                    except OSError:
+                    except (OSError, NotImplementedError):  # no hard links here: keep a copy
                         shutil.copy2(dest, backup / name, follow_symlinks=False)
                 os.replace(staging / name, dest)
             except OSError as err:

@@ -378,6 +378,10 @@ def test_the_python_api_raises_only_camcad_errors_for_unreadable_files(tmp_path)
     latin1.write_bytes(HARMONIC.read_bytes().replace(b'name = "', b'name = "\xe9', 1))
     with pytest.raises(DesignError, match="cannot read design file"):
         camcad.load(latin1)
+    with pytest.raises(DesignError, match="embedded null byte"):
+        camcad.load(str(tmp_path / "a\0b.toml"))
+    with pytest.raises(OutputError, match="NUL"):
+        camcad.load(HARMONIC).build(tmp_path / "o\0ut", only=["dxf"])
     blocker = tmp_path / "file"
     blocker.write_text("x")
     with pytest.raises(OutputError, match="--output") as info:
