@@ -166,7 +166,7 @@ def _process_alive(pid: int) -> bool:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except OSError:  # e.g. another user's process
+    except (OSError, OverflowError):  # another user's process, or not a process id: leave it
         return True
     return True
 
@@ -375,7 +375,8 @@ def _outside_staging(err: OSError, staging: Path, outdir: Path) -> OSError:
         relative = Path(os.fsdecode(path)).relative_to(staging)
     except ValueError:
         return err
-    public = outdir.joinpath(*[_public_name(part) for part in relative.parts])
+    parts = [_public_name(part) for part in relative.parts]
+    public = outdir if any(part.startswith(".") for part in parts) else outdir.joinpath(*parts)  # ours
     if not isinstance(err, OutputError):
         return OutputError.from_os_error(err, public)
     new = OutputError(public, err.problem, err.advice)
@@ -416,12 +417,12 @@ def staged_folder(outdir: str | os.PathLike[str]) -> Iterator[StagedFolder]:
     try:
         try:
             yield StagedFolder(path=staging, target=target)
+            _commit(staging, target)
         except OSError as err:
             mapped = _outside_staging(err, staging, target)
             if mapped is err:
                 raise
             raise mapped from err
-        _commit(staging, target)
     finally:
         with _signals_held():
             shutil.rmtree(staging, ignore_errors=True)
