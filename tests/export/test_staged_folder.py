@@ -206,3 +206,22 @@ def test_a_second_build_waits_for_the_lock_and_gives_up_with_a_clear_error(tmp_p
         (staging.path / "a.csv").write_text("new")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
     assert (out / "a.csv").read_text() == "new"
+
+
+def test_an_os_error_of_the_move_itself_names_the_output_folder(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "a.csv").write_text("old")
+    before = tree(tmp_path)
+    real_mkdir = Path.mkdir
+
+    def mkdir(self, *args, **kwargs):
+        if self.parent.name.startswith(".out.camcad-"):  # camcad's own bookkeeping inside the staging folder
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(self))
+        return real_mkdir(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "mkdir", mkdir)
+    with pytest.raises(OutputError) as info, staged_folder(out) as staging:
+        (staging.path / "a.csv").write_text("new")
+    assert str(info.value).startswith(f"--output: cannot write {out}: no space left on device; free space")
+    assert tree(tmp_path) == before
