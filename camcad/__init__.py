@@ -8,7 +8,7 @@
 
 from camcad._version import __version__
 from camcad.design import Design, load_design, parse_design
-from camcad.errors import CamcadError, DesignError, DesignLimitError
+from camcad.errors import CamcadError, DesignError, DesignLimitError, OutputError, UsageError
 from camcad.geometry.cam import Cam
 from camcad.motion.laws import LAWS, make_law
 from camcad.motion.program import Motion, MotionProgram
@@ -36,7 +36,9 @@ __all__ = [
     "DesignLimitError",
     "Motion",
     "MotionProgram",
+    "OutputError",
     "Project",
+    "UsageError",
     "__version__",
     "analyse",
     "build",

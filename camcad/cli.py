@@ -1,28 +1,44 @@
 """The camcad command line: build, check, size, compare, laws.
 
-Exit codes: 0 success, 2 invalid input (usage, unreadable or invalid design,
-unwritable output), 3 a design limit violated (undercut, gouge, jump,
-pressure angle or stress limit), 1 anything unexpected.
+Exit codes (defined in :mod:`camcad.errors`): 0 success, 2 invalid input
+(usage, unreadable or invalid design, unwritable output), 3 a design limit
+violated (undercut, gouge, jump, pressure angle or stress limit), 1 anything
+unexpected, 130 interrupted (SIGINT, SIGTERM, SIGHUP), 141 stdout closed by
+its reader (``camcad check … | head``).
 """
 
 from __future__ import annotations
 
 import argparse
+import logging
 import math
+import os
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
+from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 from camcad._version import __version__
-from camcad.errors import CamcadError, DesignLimitError, exit_code
+from camcad.errors import (
+    EXIT_INTERRUPTED,
+    EXIT_INVALID,
+    EXIT_LIMIT,
+    EXIT_OK,
+    EXIT_PIPE_CLOSED,
+    EXIT_UNEXPECTED,
+    CamcadError,
+    DesignLimitError,
+    exit_code,
+)
 
 if TYPE_CHECKING:
     from camcad.pipeline import Progress
 
 __all__ = ["build_parser", "main"]
-
-EXIT_OK, EXIT_UNEXPECTED, EXIT_INVALID, EXIT_LIMIT = 0, 1, 2, 3
 
 
 class _Parser(argparse.ArgumentParser):
@@ -58,6 +74,12 @@ def _cmd_build(args: argparse.Namespace) -> int:
         print(f"wrote {len(result.files)} files to {result.outdir}", file=sys.stderr)
         for path in result.files:
             print(f"  {path}")
+    if args.timings:
+        timings = result.analysis.timings
+        width = max(len(stage) for stage in timings)
+        for stage, seconds in timings.items():
+            print(f"{stage:<{width}}  {seconds:.3f} s")
+        print(f"{'total':<{width}}  {sum(timings.values()):.3f} s")
     return EXIT_OK
 
 
@@ -164,9 +186,11 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     for row in table:
         print("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())
     if args.output:
-        out = Path(args.output)
-        out.mkdir(parents=True, exist_ok=True)
-        path = write_compare(analyses, out / "compare.html")
+        from camcad.export.atomic import staged_folder
+
+        with staged_folder(args.output) as staging:
+            write_compare(analyses, staging.path / "compare.html")
+        path = Path(args.output) / "compare.html"
         print(f"wrote {path}", file=sys.stderr)
     return EXIT_OK
 
@@ -202,6 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="comma-separated outputs to write: tables, dxf, stl, gcode, report (summary.json always)",
     )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    p.add_argument("--timings", action="store_true", help="print the seconds each stage took (stdout)")
     p.set_defaults(handler=_cmd_build)
 
     p = sub.add_parser("check", help="validate and analyse without writing; exit 3 if a limit is violated")
@@ -222,14 +247,67 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _interrupt(signum: int, frame: FrameType | None) -> None:
+    """SIGTERM and SIGHUP end a run like Ctrl-C: clean up, exit 130."""
+    raise KeyboardInterrupt
+
+
+@contextmanager
+def _terminate_like_interrupt() -> Iterator[None]:
+    """Map SIGTERM and SIGHUP to KeyboardInterrupt while the block runs (main thread only)."""
+    names = ("SIGTERM", "SIGHUP")
+    signums = [getattr(signal, n) for n in names if hasattr(signal, n)]
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.signal(s, _interrupt) for s in signums}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at the null device, so the flush at exit does not fail on a closed pipe again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # stdout is not a real file (e.g. captured by a test)
+        pass
+
+
+@contextmanager
+def _no_library_logging() -> Iterator[None]:
+    """Keep log records of the libraries camcad uses off stderr while the block runs.
+
+    Without a handler Python prints warnings to stderr, e.g. matplotlib's
+    when the home folder is not writable; camcad's own messages are its errors.
+    """
+    root = logging.getLogger()
+    handler = logging.NullHandler()
+    root.addHandler(handler)
+    try:
+        yield
+    finally:
+        root.removeHandler(handler)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the camcad command line and return the exit code."""
     args = build_parser().parse_args(argv)
     try:
-        return int(args.handler(args))
+        with _terminate_like_interrupt(), _no_library_logging():
+            code = int(args.handler(args))
+            sys.stdout.flush()
+        return code
     except KeyboardInterrupt:
         print("camcad: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_PIPE_CLOSED
     except DesignLimitError as err:
         print(f"camcad: design limit: {err}", file=sys.stderr)
         return exit_code(err)

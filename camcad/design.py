@@ -640,10 +640,10 @@ def load_design(path: str | Path) -> Design:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a BOM at the start is accepted
     except FileNotFoundError:
         raise DesignError("", f"design file not found: {path}") from None
-    except (OSError, UnicodeDecodeError) as err:
+    except (OSError, ValueError) as err:  # ValueError: not UTF-8, or a NUL in the path
         raise DesignError("", f"cannot read design file {path}: {err}") from None
     try:
         data = tomllib.loads(text)

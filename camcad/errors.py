@@ -1,12 +1,25 @@
 """The camcad error hierarchy and the exit code each error maps to.
 
-``DesignError`` is bad input (exit 2); ``DesignLimitError`` is a valid design
-that breaks a limit the user cannot ignore, such as undercut or gouge (exit 3).
+Exit codes are defined here once: each error class carries its code in the
+class attribute ``exit_code`` and :func:`exit_code` maps any exception.
+``DesignError`` is bad input (exit 2), with its subclass ``UsageError`` for
+a bad command-line option; ``OutputError`` is an output file or folder that
+cannot be written (exit 2); ``DesignLimitError`` is a valid design that breaks
+a limit the user cannot ignore, such as undercut or gouge (exit 3).
 """
 
 from __future__ import annotations
 
+import errno
+import os
+
 __all__ = [
+    "EXIT_INTERRUPTED",
+    "EXIT_INVALID",
+    "EXIT_LIMIT",
+    "EXIT_OK",
+    "EXIT_PIPE_CLOSED",
+    "EXIT_UNEXPECTED",
     "CamcadError",
     "DesignError",
     "DesignLimitError",
@@ -14,13 +27,25 @@ __all__ = [
     "FitError",
     "GougeError",
     "JumpError",
+    "NotStarShapedError",
+    "OutputError",
     "UndercutError",
+    "UsageError",
     "exit_code",
 ]
+
+EXIT_OK = 0
+EXIT_UNEXPECTED = 1
+EXIT_INVALID = 2  # bad input: usage, design file, output folder
+EXIT_LIMIT = 3  # a design limit is violated
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, also used for SIGTERM and SIGHUP
+EXIT_PIPE_CLOSED = 141  # 128 + SIGPIPE: the reader of stdout went away
 
 
 class CamcadError(Exception):
     """Base class for all camcad errors."""
+
+    exit_code: int = EXIT_UNEXPECTED
 
 
 class DesignError(CamcadError, ValueError):
@@ -39,9 +64,69 @@ class DesignError(CamcadError, ValueError):
         self.message = message
         super().__init__(f"{path}: {message}" if path else message)
 
+    exit_code = EXIT_INVALID
+
+
+class UsageError(DesignError):
+    """A command-line option has a value that is not allowed (CLI exit 2); ``path`` is the option."""
+
+
+# What to do about an operating-system error while writing output, by errno.
+_OUTPUT_ADVICE = {
+    errno.ENOSPC: "free space on that disk or choose another --output",
+    errno.EDQUOT: "free space within your disk quota or choose another --output",
+    errno.EACCES: "make it writable or choose another --output",
+    errno.EPERM: "make it writable or choose another --output",
+    errno.EROFS: "the disk is read-only; choose another --output",
+    errno.EEXIST: "remove or rename it, or choose another --output",
+    errno.EISDIR: "a folder of that name is in the way; remove or rename it, or choose another --output",
+    errno.ENOTDIR: "a file is in the way of a folder; remove or rename it, or choose another --output",
+    errno.ENAMETOOLONG: "choose a shorter --output",
+}
+
+
+class OutputError(CamcadError, OSError):
+    """An output file or folder cannot be written (CLI exit 2).
+
+    The message names ``--output``, the real path the user asked for (never
+    a hidden temporary one), what went wrong and what to do.
+
+    Parameters
+    ----------
+    path
+        The file or folder in the user's output folder.
+    problem
+        What went wrong, e.g. ``"no space left on device"``.
+    advice
+        What to do; empty when there is nothing useful to say.
+    """
+
+    exit_code = EXIT_INVALID
+
+    def __init__(self, path: str | os.PathLike[str], problem: str, advice: str = "") -> None:
+        self.path = os.fspath(path)
+        self.problem = problem
+        self.advice = advice
+        super().__init__(f"--output: cannot write {self.path}: {problem}" + (f"; {advice}" if advice else ""))
+        self.filename = self.path
+
+    def __str__(self) -> str:
+        """The one-line message (``OSError`` would format errno and filename instead)."""
+        return str(self.args[0])
+
+    @classmethod
+    def from_os_error(cls, err: OSError, path: str | os.PathLike[str]) -> OutputError:
+        """The error for ``err`` raised while writing ``path``, with advice chosen by its errno."""
+        problem = (err.strerror or str(err) or type(err).__name__).lower()
+        new = cls(path, problem, _OUTPUT_ADVICE.get(err.errno or 0, "choose another --output"))
+        new.errno = err.errno
+        return new
+
 
 class DesignLimitError(CamcadError):
     """A valid design violates a hard design limit (CLI exit 3)."""
+
+    exit_code = EXIT_LIMIT
 
 
 class UndercutError(DesignLimitError):
@@ -82,15 +167,27 @@ class FitError(CamcadError):
         self.best_error = best_error
         self.control_points = control_points
 
+    exit_code = EXIT_LIMIT
+
 
 class ExportError(CamcadError):
     """An export produced a file that failed its own check (e.g. a non-manifold solid)."""
 
 
+class NotStarShapedError(DesignLimitError, ExportError):
+    """A ray from the cam axis meets the profile twice, so a polar table (lift.csv) cannot be written."""
+
+
 def exit_code(err: BaseException) -> int:
-    """Map an exception to the CLI exit code: 2 bad input, 3 design limit, 1 otherwise."""
-    if isinstance(err, (DesignError, OSError)):
-        return 2
-    if isinstance(err, (DesignLimitError, FitError)):
-        return 3
-    return 1
+    """Map an exception to the CLI exit code: 2 bad input, 3 design limit, 1 otherwise.
+
+    A camcad error carries its code; any other ``OSError`` is an unreadable
+    input or unwritable output (2); ``KeyboardInterrupt`` is 130.
+    """
+    if isinstance(err, CamcadError):
+        return err.exit_code
+    if isinstance(err, OSError):
+        return EXIT_INVALID
+    if isinstance(err, KeyboardInterrupt):
+        return EXIT_INTERRUPTED
+    return EXIT_UNEXPECTED

@@ -20,7 +20,7 @@ import numpy as np
 from camcad.analysis import Analysis, motion_summary
 from camcad.design import Design, load_design
 from camcad.dynamics import analyse_dynamics
-from camcad.errors import DesignError
+from camcad.errors import UsageError
 from camcad.export.atomic import staged_folder
 from camcad.export.records import write_csv, write_json, write_text
 from camcad.fit import fit_cam_profile
@@ -185,7 +185,7 @@ def _groups(only: Iterable[str] | None) -> set[str]:
     chosen = {aliases.get(g, g) for g in chosen}
     unknown = sorted(chosen - set(OUTPUT_GROUPS))
     if unknown:
-        raise DesignError("--only", f"unknown output {unknown[0]!r} (allowed: {', '.join(OUTPUT_GROUPS)})")
+        raise UsageError("--only", f"unknown output {unknown[0]!r} (allowed: {', '.join(OUTPUT_GROUPS)})")
     return chosen
 
 
@@ -198,9 +198,20 @@ def build(
 ) -> BuildResult:
     """Analyse the design and write its files into ``outdir`` all at once.
 
-    Everything is written into a temporary folder beside ``outdir`` first; the
+    Everything is written into a hidden folder beside ``outdir`` first; the
     files are moved into ``outdir`` only when every stage has succeeded, so a
-    failed build leaves ``outdir`` exactly as it was.
+    failed build leaves ``outdir`` exactly as it was and nothing beside it
+    (see :func:`camcad.export.atomic.staged_folder`).
+
+    Raises
+    ------
+    UsageError
+        When ``only`` names an unknown output (path ``--only``).
+    OutputError
+        When ``outdir`` or a file in it cannot be written (path ``--output``).
+    DesignLimitError
+        When the design breaks a hard limit (undercut, gouge, fit, a table the
+        profile cannot give).
     """
     groups = _groups(only)
     outdir = Path(outdir)

@@ -355,9 +355,6 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
         title = {"gcode": "G-code"}.get(name, name.capitalize())
         body = _mapping_table(section, skip=("warnings",)) if isinstance(section, Mapping) else _cell(section)
         out.append(f'<div id="table-{name}"><h3>{_e(title)}</h3>{body}</div>')
-    if analysis.timings:
-        rows = [[_e(k), _e(_num(v, ".3f"))] for k, v in analysis.timings.items()]
-        out.append(f"<div><h3>Timings [s]</h3>{_table(None, rows)}</div>")
     joints = motion.get("joints")
     if joints:
         out.append(

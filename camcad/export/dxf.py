@@ -36,7 +36,10 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
-import ezdxf
+# First: this imports ezdxf without the user's config files and font cache.
+from camcad.export._ezdxf import ezdxf, save_reproducible
+
+# isort: split
 import numpy as np
 from ezdxf import zoom
 from ezdxf.document import Drawing
@@ -262,7 +265,7 @@ def profile_poly_document(*, cam: Cam, fit: _Fit, design: Design) -> Drawing:
 
 
 def _save(doc: Drawing, path: str | os.PathLike[str]) -> Path:
-    return atomic_write(path, lambda tmp: doc.saveas(tmp))
+    return atomic_write(path, lambda tmp: save_reproducible(doc, tmp))
 
 
 def write_profile_dxf(path: str | os.PathLike[str], *, cam: Cam, fit: _Fit, design: Design) -> Path:

@@ -37,7 +37,7 @@ import numpy as np
 
 from camcad._typing import FloatArray, readonly
 from camcad.design import Design, Rotation
-from camcad.errors import ExportError
+from camcad.errors import NotStarShapedError
 from camcad.export.records import write_csv
 
 if TYPE_CHECKING:
@@ -92,7 +92,7 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation) -> FloatArr
 
     Raises
     ------
-    ExportError
+    NotStarShapedError
         When the profile is not star-shaped about the cam axis (a ray crosses
         it more than once), so a polar radius is not defined.
 
@@ -110,7 +110,7 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation) -> FloatArr
     angle = np.unwrap(_ray_angle(cam.profile(grid).point, sign))
     if np.any(np.diff(angle) <= 0.0):
         bad = float(grid[int(np.argmax(np.diff(angle) <= 0.0))])
-        raise ExportError(
+        raise NotStarShapedError(
             f"the profile is not star-shaped about the cam axis near cam angle "
             f"{math.degrees(bad):.2f}°: a ray meets it twice, so lift.csv has no polar radius"
         )
@@ -182,7 +182,7 @@ def write_lift_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> Pa
 
     Raises
     ------
-    ExportError
+    NotStarShapedError
         When the profile is not star-shaped about the cam axis.
     """
     angle = table_angles(design.tables.step)

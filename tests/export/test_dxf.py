@@ -10,6 +10,7 @@ import ezdxf
 import numpy as np
 import pytest
 from ezdxf import recover
+from ezdxf.entitydb import EntityDB
 from ezdxf.math import bulge_to_arc
 from numpy.testing import assert_allclose
 from scipy.spatial import cKDTree
@@ -218,3 +219,25 @@ def test_periodic_curve_is_refused_and_nothing_is_written(case, tmp_path):
     with pytest.raises(ExportError, match="periodic"):
         write_profile_dxf(tmp_path / "profile.dxf", cam=cam, fit=bad, design=design)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "order", [sorted, lambda types: sorted(types, reverse=True)], ids=["sorted", "reversed"]
+)
+def test_the_same_drawing_gives_the_same_bytes(case, tmp_path, monkeypatch, order):
+    """No clock, no random GUID, and the CLASSES section does not follow ezdxf's set order."""
+    design, cam, fit = case
+    reference = write_profile_dxf(tmp_path / "one.dxf", cam=cam, fit=fit, design=design).read_bytes()
+    in_use = EntityDB.dxf_types_in_use
+    monkeypatch.setattr(EntityDB, "dxf_types_in_use", lambda self: order(in_use(self)))
+    option = ezdxf.options.write_fixed_meta_data_for_testing
+    again = write_profile_dxf(tmp_path / "two.dxf", cam=cam, fit=fit, design=design).read_bytes()
+    assert again == reference
+    assert ezdxf.options.write_fixed_meta_data_for_testing == option  # the user's setting is restored
+    lines = (tmp_path / "two.dxf").read_text().splitlines()  # raw: ezdxf replaces nil GUIDs when reading
+
+    def header(name: str) -> str:  # a header variable is: name, group code, value
+        return lines[lines.index(name) + 2]
+
+    assert header("$FINGERPRINTGUID") == header("$VERSIONGUID") == "{00000000-0000-0000-0000-000000000000}"
+    assert header("$TDCREATE") == header("$TDUPDATE")
