@@ -43,6 +43,9 @@ class Analysis:
         The planned G-code toolpath, or None when not requested.
     timings
         Seconds per stage.
+    stage_findings
+        Hard limits the fit or the toolpath plan found (fit tolerance
+        unreachable, gouge) when the analysis was not strict.
     """
 
     design: Design
@@ -53,11 +56,12 @@ class Analysis:
     fit: ProfileFit | None
     toolpath: Any
     timings: dict[str, float] = field(default_factory=dict)
+    stage_findings: tuple[Finding, ...] = ()
 
     @property
     def findings(self) -> tuple[Finding, ...]:
         """Every broken limit of every stage, hard ones first (see :mod:`camcad.findings`)."""
-        found = (*self.geometry.findings, *self.dynamics.findings)
+        found = (*self.geometry.findings, *self.dynamics.findings, *self.stage_findings)
         return tuple(sorted(found, key=lambda f: not f.hard))
 
     @property

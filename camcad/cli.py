@@ -66,7 +66,7 @@ def _cmd_build(args: argparse.Namespace) -> int:
     only = args.only.split(",") if args.only else None
     if not args.quiet:
         print(f"camcad {__version__}: building {design.cam.name!r} from {args.design}", file=sys.stderr)
-    result = build(design, args.output, only=only, progress=_progress(args.quiet))
+    result = build(design, args.output, only=only, progress=_progress(args.quiet), strict=args.strict)
     warnings = result.analysis.warnings
     if not args.quiet:
         for w in warnings:
@@ -121,33 +121,23 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from camcad.design import load_design
-    from camcad.errors import FitError, GougeError
     from camcad.pipeline import analyse
 
     design = load_design(args.design)
-    violations: list[str] = []
-    extra: list[str] = []
-    try:
-        analysis = analyse(design, strict=False, toolpath=True)
-    except (GougeError, FitError) as err:
-        analysis = analyse(design, strict=False, toolpath=False)
-        violations.append("gouge" if isinstance(err, GougeError) else "fit")
-        extra.append(str(err))
-    summary = analysis.summary()
-    violations = analysis.violations + violations
-    rows = _check_rows(summary, design)
+    analysis = analyse(design, strict=False, toolpath=True)
+    rows = _check_rows(analysis.summary(), design)
     width = max(len(k) for k, _ in rows)
     print(f"{design.cam.name} ({args.design})")
     for key, value in rows:
         print(f"  {key:<{width}}  {value}")
-    if analysis.geometry.undercut is not None:
-        from camcad.geometry import undercut_error
-
-        extra.append(str(undercut_error(analysis.geometry, min_curvature_radius=design.min_curvature_radius)))
-    for w in [*analysis.warnings, *extra]:
-        print(f"  warning: {w}")
-    if violations:
-        print(f"design limits violated: {', '.join(dict.fromkeys(violations))}")
+    limits = {f.message for f in analysis.findings}
+    for finding in analysis.findings:
+        print(f"  {'hard' if finding.hard else 'soft'} limit: {finding.message}")
+    for w in analysis.warnings:
+        if w not in limits:
+            print(f"  note: {w}")
+    if analysis.violations:
+        print(f"design limits violated: {', '.join(analysis.violations)}")
         return EXIT_LIMIT
     print("all design limits hold")
     return EXIT_OK
@@ -227,6 +217,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     p.add_argument("--timings", action="store_true", help="print the seconds each stage took (stdout)")
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="treat soft limits (pressure angle, contact stress, follower jump) as errors: exit 3, no files",
+    )
     p.set_defaults(handler=_cmd_build)
 
     p = sub.add_parser("check", help="validate and analyse without writing; exit 3 if a limit is violated")

@@ -129,8 +129,9 @@ class FollowerSpec:
 
     kind: FollowerKind = FollowerKind.TRANSLATING_ROLLER
     roller_radius: float = 0.0
-    offset: float = 0.0  # e > 0 puts the follower axis at x = +e (ccw)
+    offset: float = 0.0  # e > 0 puts the follower axis at x = +e, whatever the rotation
     face_width: float | None = None
+    face_margin: float = 1.0  # mm beyond the contact's travel at each edge of a flat face
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -343,6 +344,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "roller_radius": _Rule("float", 0.0, check=_non_negative),
         "offset": _Rule("float", 0.0),
         "face_width": _Rule("float", None, check=_positive),
+        "face_margin": _Rule("float", 1.0, check=_non_negative),
     },
     "dynamics": {
         "model": _Rule("enum", DynamicsModel.ENERGY, enum=DynamicsModel),

@@ -20,9 +20,10 @@ import numpy as np
 from camcad.analysis import Analysis, motion_summary
 from camcad.design import Design, load_design
 from camcad.dynamics import analyse_dynamics
-from camcad.errors import UsageError
+from camcad.errors import DesignLimitError, FitError, GougeError, UsageError
 from camcad.export.atomic import staged_folder
 from camcad.export.records import write_csv, write_json, write_text
+from camcad.findings import Finding, Severity
 from camcad.fit import fit_cam_profile
 from camcad.geometry import Cam, analyse_geometry, undercut_error
 
@@ -108,15 +109,19 @@ def analyse(
     fit, toolpath
         Whether to run the NURBS fit and plan the G-code toolpath.
     strict
-        Raise on hard limits (undercut; gouge from the toolpath plan). With
-        ``strict=False`` an undercut is only recorded (``camcad check``).
+        Raise on hard limits (undercut, face width, velocity jump, gouge, fit
+        tolerance unreachable). With ``strict=False`` they are recorded as
+        hard :class:`~camcad.findings.Finding` s instead (``camcad check``),
+        and the stages that need a usable profile (fit, toolpath) are skipped
+        when geometry already found one.
     progress
         Called after each stage with its name and duration.
 
     Raises
     ------
-    UndercutError, GougeError, FitError
-        When ``strict`` and the design breaks a hard limit.
+    DesignLimitError
+        When ``strict`` and the design breaks a hard limit (``UndercutError``,
+        ``GougeError``, ``FitError`` among them).
     """
     timings: dict[str, float] = {}
     cam = Cam.from_design(design)
@@ -125,12 +130,19 @@ def analyse(
         progress,
         "geometry",
         lambda: analyse_geometry(
-            cam, max_pressure_angle=design.cam.max_pressure_angle, face_width=design.follower.face_width
+            cam,
+            max_pressure_angle=design.cam.max_pressure_angle,
+            face_width=design.follower.face_width,
+            face_margin=design.follower.face_margin,
+            min_curvature_radius=design.min_curvature_radius,
         ),
     )
     motion = cam.motion(geometry.phi)
-    if geometry.undercut is not None and strict:
-        raise undercut_error(geometry, min_curvature_radius=design.min_curvature_radius)
+    hard = [f for f in geometry.findings if f.hard]
+    if hard and strict:
+        if geometry.undercut is not None:
+            raise undercut_error(geometry, min_curvature_radius=design.min_curvature_radius)
+        raise DesignLimitError(hard[0].message)
     dynamics = _timed(
         timings,
         progress,
@@ -143,28 +155,43 @@ def analyse(
             cam=cam,
         ),
     )
+    later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
     fitted = None
-    if fit and geometry.undercut is None:
-        fitted = _timed(
-            timings,
-            progress,
-            "fit",
-            lambda: fit_cam_profile(
-                cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
-            ),
-        )
+    if fit and not hard:
+        try:
+            fitted = _timed(
+                timings,
+                progress,
+                "fit",
+                lambda: fit_cam_profile(
+                    cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
+                ),
+            )
+        except FitError as err:
+            if strict:
+                raise
+            later.append(_hard_finding("fit tolerance", "fit.tolerance", err))
     planned = None
-    if toolpath and geometry.undercut is None:
+    if toolpath and not hard:
         from camcad.export.gcode import plan_toolpath
 
-        planned = _timed(
-            timings,
-            progress,
-            "toolpath",
-            lambda: plan_toolpath(
-                cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
-            ),
-        )
+        try:
+            planned = _timed(
+                timings,
+                progress,
+                "toolpath",
+                lambda: plan_toolpath(
+                    cam,
+                    design.gcode,
+                    name=design.cam.name,
+                    thickness=design.cam.thickness,
+                    bore=design.cam.bore,
+                ),
+            )
+        except GougeError as err:
+            if strict:
+                raise
+            later.append(_hard_finding("gouge", "gcode.tool_diameter", err))
     return Analysis(
         design=design,
         cam=cam,
@@ -174,7 +201,13 @@ def analyse(
         fit=fitted,
         toolpath=planned,
         timings=timings,
+        stage_findings=tuple(later),
     )
+
+
+def _hard_finding(kind: str, field: str, err: Exception) -> Finding:
+    """A hard finding for a limit error a later stage raised (its message names the field)."""
+    return Finding(kind=kind, severity=Severity.HARD, field=getattr(err, "field", field), message=str(err))
 
 
 def _groups(only: Iterable[str] | None) -> set[str]:
@@ -195,6 +228,7 @@ def build(
     *,
     only: Iterable[str] | None = None,
     progress: Progress | None = None,
+    strict: bool = False,
 ) -> BuildResult:
     """Analyse the design and write its files into ``outdir`` all at once.
 
@@ -210,13 +244,18 @@ def build(
     OutputError
         When ``outdir`` or a file in it cannot be written (path ``--output``).
     DesignLimitError
-        When the design breaks a hard limit (undercut, gouge, fit, a table the
-        profile cannot give).
+        When the design breaks a hard limit (undercut, face width, velocity
+        jump, gouge, fit, a table the profile cannot give), or with ``strict``
+        a soft one (pressure angle, contact stress, follower jump).
     """
     groups = _groups(only)
     outdir = Path(outdir)
     with staged_folder(outdir) as staging:
         analysis = analyse(design, fit=True, toolpath="gcode" in groups, progress=progress)
+        soft = [f for f in analysis.findings if not f.hard]
+        if strict and soft:
+            listed = "; ".join(f"{f.field}: {f.message}" for f in soft)
+            raise DesignLimitError(f"--strict: {len(soft)} soft limit(s) broken: {listed}")
         written = _write_outputs(analysis, staging.path, groups=groups, progress=progress)
         written.append(write_json(staging.path / "summary.json", analysis.summary()))
     return BuildResult(analysis=analysis, outdir=outdir, files=tuple(outdir / Path(p).name for p in written))
