@@ -166,7 +166,7 @@ class _Names:
 
     tolerance: str = "tolerance"
     max_control_points: str = "max_control_points"
-    samples: str = "points"
+    samples: str | None = "points"  # None: the caller chose the samples, not the user
 
 
 class SamplesTooFewError(FitError):
@@ -375,7 +375,8 @@ def _unreachable(search: _Search) -> FitError:
     (the caller's ``max_control_points``, or ``AUTO_MAX_CONTROL_POINTS``)
     and the room the samples leave (``MIN_SAMPLE_GAP`` samples between
     knots). The message names the binding one: the budget, the samples, or
-    (with the automatic budget) the tolerance itself.
+    the tolerance itself when the budget is automatic or the samples were
+    not the user's choice.
     """
     prob, names = search.problem, search.problem.names
     best, err = _best_certified(search)
@@ -386,6 +387,13 @@ def _unreachable(search: _Search) -> FitError:
         at_best += f" with {prob.control_points(best)} control points"
     cps = prob.control_points(best) if best is not None else reached
     budget = prob.max_control_points - prob.control_points(0)
+    if search.coarse.room() < budget and names.samples is None:
+        return SamplesTooFewError(
+            f"{names.tolerance}: {prob.tolerance:.3g} mm is out of reach: {len(prob.points)} samples "
+            f"leave room for at most {reached} control points ({at_best}); relax {names.tolerance}",
+            best_error=err,
+            control_points=cps,
+        )
     if search.coarse.room() < budget:
         return SamplesTooFewError(
             f"{names.samples}: {len(prob.points)} samples leave room for at most {reached} control "

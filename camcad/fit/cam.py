@@ -48,11 +48,16 @@ def fit_cam_profile(
     ------
     FitError
         The tolerance cannot be met; the message names the knob that binds
-        (``fit.tolerance``, ``fit.max_control_points`` or
-        ``cam.sample_step_deg``), its value and the control points reached.
+        (``fit.max_control_points`` when the budget stops the search,
+        ``fit.tolerance`` when the automatic budget or the finest sampling
+        does, ``step`` when the caller's step does), its value and the
+        control points reached. ``cam.sample_step_deg`` is never the cause:
+        the fit does not use a step coarser than 0.1°.
     """
     names = _Names(
-        tolerance="fit.tolerance", max_control_points="fit.max_control_points", samples="cam.sample_step_deg"
+        tolerance="fit.tolerance",
+        max_control_points="fit.max_control_points",
+        samples=None if step is None else "step",
     )
     h = min(cam.sample_step, FIT_STEP) if step is None else step
     for attempt in range(REFINEMENTS + 1):
