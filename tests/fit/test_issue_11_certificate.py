@@ -58,7 +58,9 @@ def dense_distance(curve, points: np.ndarray, chunk: int = 250_000) -> np.ndarra
         for _ in range(3):  # (C − P)·C' = 0 by Newton
             r = spline(u) - p
             c1, c2 = d1(u), d2(u)
-            u = u - np.einsum("ij,ij->i", r, c1) / (np.einsum("ij,ij->i", c1, c1) + np.einsum("ij,ij->i", r, c2))
+            u = u - np.einsum("ij,ij->i", r, c1) / (
+                np.einsum("ij,ij->i", c1, c1) + np.einsum("ij,ij->i", r, c2)
+            )
         out[lo : lo + chunk] = np.minimum(np.hypot(*(spline(u) - p).T), near_d)
     return out
 
@@ -135,7 +137,8 @@ def test_certify_exact_finds_a_bump_the_samples_and_midpoints_miss():
     feet = project(curve, points, phi / (2 * np.pi)).foot
     mids = exact(phi + np.pi / 36)
     old_style = max(
-        project(curve, points, feet).max_error, project(curve, mids, (phi + np.pi / 36) / (2 * np.pi)).max_error
+        project(curve, points, feet).max_error,
+        project(curve, mids, (phi + np.pi / 36) / (2 * np.pi)).max_error,
     )
     assert old_style < 0.1 * height  # the sample + midpoint check sees almost nothing
     cert = certify_exact(curve, ExactProfile(point=exact, phi=phi, breaks=np.array([])), points, feet)
@@ -172,7 +175,9 @@ def test_fit_error_names_the_budget_and_the_count_reached():
     with pytest.raises(FitError) as info:
         fit_cam_profile(sample_cam("offset_roller"), tolerance=1e-3, max_control_points=20)
     message = str(info.value)
-    assert message.startswith("fit.max_control_points: 20 control points are too few for fit.tolerance = 0.001 mm")
+    assert message.startswith(
+        "fit.max_control_points: 20 control points are too few for fit.tolerance = 0.001 mm"
+    )
     assert "reached 20" in message
     assert info.value.control_points <= 20
     assert info.value.best_error > 1e-3
@@ -197,5 +202,8 @@ def _minimal():
     return {
         "cam": {"base_radius": 40.0},
         "follower": {"type": "translating-roller", "roller_radius": 10.0},
-        "motion": [{"kind": "rise", "angle": 180, "lift": 10.0, "law": "cycloidal"}, {"kind": "dwell", "angle": 180}],
+        "motion": [
+            {"kind": "rise", "angle": 180, "lift": 10.0, "law": "cycloidal"},
+            {"kind": "dwell", "angle": 180},
+        ],
     }
