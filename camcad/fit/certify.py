@@ -24,6 +24,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
 from camcad._typing import FloatArray, readonly
 from camcad.fit.bspline import curve_derivatives
@@ -231,7 +232,9 @@ def _signed(curve: BSplineCurve, points: FloatArray, foot: FloatArray) -> FloatA
     return np.where(side < 0.0, -1.0, 1.0) * np.hypot(r[:, 0], r[:, 1])
 
 
-def _interval_bounds(phi: FloatArray, s: FloatArray, is_break: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _interval_bounds(
+    phi: FloatArray, s: FloatArray, is_break: NDArray[np.bool_]
+) -> tuple[FloatArray, FloatArray]:
     """Width h and upper bound U of |s| on each interval [φ_i, φ_i+1] of a closed node set.
 
     U = max(|s_i|, |s_i+1|) + σ M h²/8, the bound for a function with
@@ -267,7 +270,7 @@ def _start_nodes(curve: BSplineCurve, exact: ExactProfile, feet: FloatArray) -> 
     a, b = curve.domain
     period = b - a
     phi_ext = np.append(phi_s, phi0 + TWO_PI)
-    u_ext = np.append(feet, feet[0] + period)
+    u_ext = np.maximum.accumulate(np.append(feet, feet[0] + period))
     breaks = phi0 + np.mod(np.asarray(exact.breaks, dtype=float) - phi0, TWO_PI)
     knots = np.unique(curve.knots[(curve.knots >= a) & (curve.knots < b)])
     knots = np.sort(feet[0] + np.mod(knots - feet[0], period))
@@ -339,7 +342,8 @@ def certify_exact(
     s_samples = _signed(curve, pts, feet)
     cand, breaks = _start_nodes(curve, exact, feet)
     phi_s = np.asarray(exact.phi, dtype=float)
-    u0 = np.interp(cand, np.append(phi_s, phi_s[0] + TWO_PI), np.append(feet, feet[0] + period))
+    u_ext = np.maximum.accumulate(np.append(feet, feet[0] + period))
+    u0 = np.interp(cand, np.append(phi_s, phi_s[0] + TWO_PI), u_ext)
     new_pts = np.asarray(exact.point(np.mod(cand, TWO_PI)), dtype=float)
     new_foot = project(curve, new_pts, u0).foot
     phi = np.concatenate((phi_s, cand))

@@ -146,6 +146,26 @@ def test_certify_exact_finds_a_bump_the_samples_and_midpoints_miss():
     assert height <= cert.max_error <= 1.01 * height
 
 
+def test_certify_exact_is_exact_at_a_corner_on_a_breakpoint():
+    # a tent-shaped bump whose apex (a corner of the profile) is a breakpoint between samples
+    curve, _, phi, height = bumped_circle_case()
+    apex, half = 3.4 / 36, 0.01
+
+    def exact(angle):
+        u = np.asarray(angle) / (2 * np.pi)
+        c1 = curve.evaluate(u, 1)
+        normal = np.column_stack((c1[:, 1], -c1[:, 0])) / np.hypot(*c1.T)[:, None]
+        tent = height * np.maximum(0.0, 1.0 - np.abs(u - apex) / half)
+        return curve.evaluate(u) + tent[:, None] * normal
+
+    points = exact(phi)
+    feet = project(curve, points, phi / (2 * np.pi)).foot
+    profile = ExactProfile(point=exact, phi=phi, breaks=np.array([2 * np.pi * apex]))
+    cert = certify_exact(curve, profile, points, feet)
+    assert height <= cert.max_error <= 1.01 * height
+    assert cert.phi is not None and np.min(np.abs(cert.phi - 2 * np.pi * apex)) < 1e-12
+
+
 def cycloidal_128_design():
     motion = []
     for _ in range(64):
