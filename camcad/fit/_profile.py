@@ -397,7 +397,7 @@ def _unreachable(search: _Search) -> FitError:
     if search.coarse.room() < budget:
         return SamplesTooFewError(
             f"{names.samples}: {len(prob.points)} samples leave room for at most {reached} control "
-            f"points, too few for {tol} ({at_best}); sample finer ({names.samples}) or relax "
+            f"points, too few for {tol} ({at_best}); sample more finely ({names.samples}) or relax "
             f"{names.tolerance}",
             best_error=err,
             control_points=cps,
@@ -451,9 +451,27 @@ def _next_count(search: _Search, lo: int, hi: int) -> int | None:
 
 
 def _search(problem: _Problem) -> tuple[BSplineCurve, tuple[Certificate, Certificate | None]]:
-    """Smallest certified free-knot count (see the module docstring)."""
+    """Smallest certified free-knot count (see the module docstring).
+
+    The counts are compared on a subsample, which leaves room for fewer
+    knots than all samples: if its room stops the search, the search runs
+    again on a subsample four times larger (at last on all samples).
+    """
     size = max(SEARCH_SAMPLES, SEARCH_SAMPLES_PER_SEGMENT * problem.fixed.n_segments)
-    search = _Search(problem, _subsample(problem, size))
+    budget = problem.max_control_points - problem.control_points(0)
+    while True:
+        search = _Search(problem, _subsample(problem, size))
+        try:
+            return _search_on(search)
+        except FitError:
+            if search.coarse is problem or search.coarse.room() >= min(budget, problem.room()):
+                raise
+            size *= 4
+
+
+def _search_on(search: _Search) -> tuple[BSplineCurve, tuple[Certificate, Certificate | None]]:
+    """Run one search over the counts its subsample allows."""
+    problem = search.problem
     lo, hi = search.coarse.n_free_bounds()
     if hi < lo:
         raise _unreachable(search)
@@ -465,7 +483,12 @@ def _search(problem: _Problem) -> tuple[BSplineCurve, tuple[Certificate, Certifi
             continue
         passing = sorted(k for k in search.trials if search.passes(k))
         if not passing:
-            raise _unreachable(search)
+            best, err = _best_certified(
+                search
+            )  # the refit on all samples may pass where the subsample did not
+            if best is None or best in search.rejected or err > problem.tolerance:
+                raise _unreachable(search)
+            passing = [best]
         certs = search.certify(passing[0])
         err = _certified_max(certs)
         curve = search.final(passing[0]).curve
@@ -567,8 +590,8 @@ def fit_profile(
     ------
     FitError
         The tolerance cannot be met within the budget; the message names
-        the binding limit (``max_control_points``, the samples ``points``
-        or ``tolerance``) and the count reached, and the error carries the
+        the binding limit (``max_control_points``, the samples ``phi`` or
+        ``tolerance``) and the count reached, and the error carries the
         best certified error.
     ValueError
         Inconsistent input.
@@ -601,7 +624,7 @@ def fit_profile(
         tolerance=tolerance,
         max_control_points=max_control_points,
         degree=degree,
-        names=_Names(),
+        names=_Names(samples="phi"),
     )
 
 

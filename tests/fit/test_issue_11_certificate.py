@@ -191,6 +191,15 @@ def test_128_segment_program_fits_at_1_um_with_the_default_budget():
     assert dense_distance(fit.curve, np.asarray(cam.profile(phi).point)).max() <= fit.max_error
 
 
+def test_default_budget_is_not_capped_by_the_search_subsample():
+    # 5 nm needs about 600 control points: more than the 1200-sample search subsample leaves room for
+    cam = sample_cam("offset_roller")
+    fit = fit_cam_profile(cam, tolerance=5e-9)
+    assert fit.control_points > 550
+    assert fit.max_error <= 5e-9
+    assert dense_distance(fit.curve, dense_profile("offset_roller", 200_000)).max() <= fit.max_error
+
+
 def test_fit_error_names_the_budget_and_the_count_reached():
     with pytest.raises(FitError) as info:
         fit_cam_profile(sample_cam("offset_roller"), tolerance=1e-3, max_control_points=20)
