@@ -483,9 +483,8 @@ def _search_on(search: _Search) -> tuple[BSplineCurve, tuple[Certificate, Certif
             continue
         passing = sorted(k for k in search.trials if search.passes(k))
         if not passing:
-            best, err = _best_certified(
-                search
-            )  # the refit on all samples may pass where the subsample did not
+            # the refit on all samples may pass where the subsample did not
+            best, err = _best_certified(search)
             if best is None or best in search.rejected or err > problem.tolerance:
                 raise _unreachable(search)
             passing = [best]

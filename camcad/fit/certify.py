@@ -334,6 +334,15 @@ def certify_exact(
     intervals near the largest errors, and the result does not depend on
     the sample step. New points are projected with :func:`project` from the
     interpolated foot parameters of their neighbours.
+
+    The bound rests on the second difference seeing s'' between nodes: true
+    when the starting nodes resolve every extremum of s. The error of a
+    cubic least-squares fit has a few extrema per knot span and the exact
+    profile is smooth between breakpoints, hence eight nodes per knot span
+    and per stretch between breakpoints (and a 1° grid); a feature narrower
+    than that which no node touches could be missed. Against a dense check
+    of 10^6 points on the shipped samples at sample steps 0.1°–9.9° the
+    bound is never below it and at most 0.1 % above.
     """
     a, b = curve.domain
     period = b - a
