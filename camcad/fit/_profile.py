@@ -45,6 +45,7 @@ import numpy as np
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import FitError
+from camcad.fit._limits import Names, limit_error
 from camcad.fit.bspline import (
     SplineFit,
     chord_length_params,
@@ -63,6 +64,7 @@ from camcad.fit.knots import (
     fixed_knots,
     place_knots,
 )
+from camcad.fit.result import ProfileFit
 from camcad.fit.seam import longest_stretch, seam_parameter
 
 __all__ = ["ProfileFit", "fit_points", "fit_profile"]
@@ -77,103 +79,6 @@ AUTO_MAX_CONTROL_POINTS = 2500  # default budget: a 2500² float64 normal matrix
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class ProfileFit:
-    """A B-spline fitted to a profile, with its error certificate.
-
-    Attributes
-    ----------
-    curve
-        Periodic curve (closed input) or clamped open curve (open input);
-        parameter domain [0, 1] in normalised chord length.
-    clamped
-        Clamped export form of the same curve. For closed input it opens at
-        ``seam`` and its domain is [0, 1] again: ``clamped.evaluate(v)``
-        equals ``curve.evaluate(v + seam)``; and
-        ``control_points[-1] == control_points[0]``. For open input it is
-        ``curve``.
-    params
-        (n,) increasing foot-point parameter of each input sample on
-        ``curve``: the curve point nearest the sample is
-        ``curve.evaluate(params)``. For closed input the first may lie a hair
-        below 0 (its foot point precedes u = 0); ``curve`` wraps it. On
-        ``clamped`` use :attr:`clamped_params`.
-    tolerance
-        Requested tolerance [mm].
-    max_error
-        Certified max distance from the exact profile to the curve [mm]:
-        an upper bound over the whole turn (within 0.1 % of the largest
-        distance found), whatever the sample step; for :func:`fit_points`,
-        the max over the given points.
-    rms_error
-        RMS distance of the samples to the curve [mm].
-    control_points
-        Number of control points of the clamped form.
-    degree
-        Degree p.
-    seam_tangent_jump
-        Angle between the tangents either side of the seam of the clamped
-        form [rad] (0 for open input).
-    seam_curvature_jump
-        |Δκ| across the seam of the clamped form [1/mm] (0 for open input).
-    seam
-        Parameter u_s of ``curve`` where ``clamped`` starts: inside the
-        longest stretch between motion breakpoints (:mod:`camcad.fit.seam`),
-        so the seam adds no tangent or curvature jump and the exported spline
-        does not start at a joint; 0 without breakpoints and for open input.
-    """
-
-    curve: BSplineCurve
-    clamped: BSplineCurve
-    params: FloatArray
-    tolerance: float
-    max_error: float
-    rms_error: float
-    control_points: int
-    degree: int
-    seam_tangent_jump: float
-    seam_curvature_jump: float
-    seam: float = 0.0
-
-    @property
-    def clamped_params(self) -> FloatArray:
-        """(n,) ``params`` on ``clamped``: ``np.mod(params − seam, 1)``.
-
-        ``clamped.evaluate(clamped_params)`` equals ``curve.evaluate(params)``;
-        for closed input they increase from the first sample past the seam
-        and drop by one period once.
-        """
-        if self.curve.periodic:
-            out = np.mod(np.asarray(self.params) - self.seam, 1.0)
-        else:
-            out = np.array(self.params)
-        readonly(out)
-        return out
-
-    def summary(self) -> dict[str, float | int]:
-        """Tolerance, errors [mm], control points and degree for the report."""
-        return {
-            "tolerance_mm": self.tolerance,
-            "max_error_mm": self.max_error,
-            "rms_error_mm": self.rms_error,
-            "control_points": self.control_points,
-            "degree": self.degree,
-        }
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class _Names:
-    """What the caller calls the knobs, for :class:`FitError` messages."""
-
-    tolerance: str = "tolerance"
-    max_control_points: str = "max_control_points"
-    samples: str | None = "points"  # None: the caller chose the samples, not the user
-
-
-class SamplesTooFewError(FitError):
-    """The samples are too sparse for the control points the tolerance needs."""
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
 class _Problem:
     """What the search needs: samples, parameters, fixed knots, limits."""
 
@@ -185,7 +90,7 @@ class _Problem:
     tolerance: float
     max_control_points: int
     automatic_budget: bool  # max_control_points is AUTO_MAX_CONTROL_POINTS, not the caller's
-    names: _Names
+    names: Names
     seam_window: tuple[float, float] | None = None  # u of the middle half of the longest stretch
 
     @property
@@ -369,57 +274,24 @@ def _best_certified(search: _Search) -> tuple[int | None, float]:
 
 
 def _unreachable(search: _Search) -> FitError:
-    """FitError naming the knob that stopped the search, the count reached and the best error.
-
-    The search stops at the smaller of two limits: the control-point budget
-    (the caller's ``max_control_points``, or ``AUTO_MAX_CONTROL_POINTS``)
-    and the room the samples leave (``MIN_SAMPLE_GAP`` samples between
-    knots). The message names the binding one: the budget, the samples, or
-    the tolerance itself when the budget is automatic or the samples were
-    not the user's choice.
-    """
-    prob, names = search.problem, search.problem.names
+    """FitError naming the knob that stopped the search (:func:`camcad.fit._limits.limit_error`)."""
+    prob = search.problem
     best, err = _best_certified(search)
-    reached = prob.control_points(max(search.trials, default=0))
-    tol = f"{names.tolerance} = {prob.tolerance:.3g} mm"
-    at_best = "no finite fit" if best is None else f"best certified error {err:.3g} mm"
-    if best is not None:
-        at_best += f" with {prob.control_points(best)} control points"
-    cps = prob.control_points(best) if best is not None else reached
-    budget = prob.max_control_points - prob.control_points(0)
-    if search.coarse.room() < budget and names.samples is None:
-        return SamplesTooFewError(
-            f"{names.tolerance}: {prob.tolerance:.3g} mm is out of reach: {len(prob.points)} samples "
-            f"leave room for at most {reached} control points ({at_best}); relax {names.tolerance}",
-            best_error=err,
-            control_points=cps,
-        )
-    if search.coarse.room() < budget:
-        return SamplesTooFewError(
-            f"{names.samples}: {len(prob.points)} samples leave room for at most {reached} control "
-            f"points, too few for {tol} ({at_best}); sample more finely ({names.samples}) or relax "
-            f"{names.tolerance}",
-            best_error=err,
-            control_points=cps,
-        )
-    if prob.automatic_budget:
-        return FitError(
-            f"{names.tolerance}: {prob.tolerance:.3g} mm is out of reach: the search reached {reached} "
-            f"control points (the automatic limit, {prob.max_control_points}), {at_best}; relax "
-            f"{names.tolerance} (or set {names.max_control_points} higher if memory allows)",
-            best_error=err,
-            control_points=cps,
-        )
-    need = ""
+    needed = None
     if best is not None and math.isfinite(err):
         est = estimate_free_knots(best, prob.fixed.n_segments, err, prob.tolerance, prob.degree)
-        need = f" (about {prob.control_points(est)} needed)"
-    return FitError(
-        f"{names.max_control_points}: {prob.max_control_points} control points are too few for {tol}: "
-        f"the search reached {reached}, {at_best}; raise {names.max_control_points}{need}, leave it "
-        f"out (automatic) or relax {names.tolerance}",
+        needed = prob.control_points(est)
+    return limit_error(
+        names=prob.names,
+        tolerance=prob.tolerance,
+        n_samples=len(prob.points),
+        max_control_points=prob.max_control_points,
+        automatic_budget=prob.automatic_budget,
+        samples_bind=search.coarse.room() < prob.max_control_points - prob.control_points(0),
+        reached=prob.control_points(max(search.trials, default=0)),
+        best=None if best is None else prob.control_points(best),
         best_error=err,
-        control_points=cps,
+        needed=needed,
     )
 
 
@@ -623,7 +495,7 @@ def fit_profile(
         tolerance=tolerance,
         max_control_points=max_control_points,
         degree=degree,
-        names=_Names(samples="phi"),
+        names=Names(samples="phi"),
     )
 
 
@@ -636,7 +508,7 @@ def _fit_closed(
     tolerance: float,
     max_control_points: int | None,
     degree: int,
-    names: _Names,
+    names: Names,
 ) -> ProfileFit:
     """:func:`fit_profile`, with the caller's names for its knobs in errors."""
     _check_options(tolerance, max_control_points, degree)
@@ -731,6 +603,6 @@ def fit_points(
         tolerance=tolerance,
         max_control_points=AUTO_MAX_CONTROL_POINTS if max_control_points is None else max_control_points,
         automatic_budget=max_control_points is None,
-        names=_Names(),
+        names=Names(),
     )
     return _result(problem, *_search(problem))

@@ -6,7 +6,9 @@ import math
 
 import numpy as np
 
-from camcad.fit._profile import ProfileFit, SamplesTooFewError, _fit_closed, _Names
+from camcad.fit._limits import Names, SamplesTooFewError
+from camcad.fit._profile import _fit_closed
+from camcad.fit.result import ProfileFit
 from camcad.geometry.cam import Cam
 
 __all__ = ["FIT_STEP", "fit_cam_profile"]
@@ -54,7 +56,7 @@ def fit_cam_profile(
         control points reached. ``cam.sample_step_deg`` is never the cause:
         the fit does not use a step coarser than 0.1°.
     """
-    names = _Names(
+    names = Names(
         tolerance="fit.tolerance",
         max_control_points="fit.max_control_points",
         samples=None if step is None else "step",
