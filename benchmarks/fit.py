@@ -11,10 +11,11 @@ Run ``python benchmarks/fit.py``; prints Markdown tables:
    capped at about a minute);
 2. cost against the number of samples (cycloidal cam).
 
-geomdl's curve is measured with camcad's own certificate (foot points of the
-samples and of exact points between samples), so both columns use the same
-yardstick. geomdl fits an open clamped curve through the closing point, so
-its seam is only C0.
+geomdl's curve is measured by foot points of the samples and of exact points
+midway between samples: a lower bound of its true error (camcad's own
+certificate bounds the distance over the whole exact profile, by adaptive
+subdivision, and so is never below it). geomdl fits an open clamped curve
+through the closing point, so its seam is only C0.
 """
 
 from __future__ import annotations

@@ -185,7 +185,7 @@ class FitSpec:
     """NURBS fit settings. ``tolerance`` mm."""
 
     tolerance: float = 1e-3
-    max_control_points: int = 500
+    max_control_points: int | None = None  # None: automatic (as many as the fit's samples allow)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -373,7 +373,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
     },
     "fit": {
         "tolerance": _Rule("float", 1e-3, check=_positive),
-        "max_control_points": _Rule("int", 500, check=lambda v: None if v >= 8 else "must be ≥ 8"),
+        "max_control_points": _Rule("int", None, check=lambda v: None if v >= 8 else "must be ≥ 8"),
     },
     "dxf": {
         "pitch_curve": _Rule("bool", True),

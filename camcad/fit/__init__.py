@@ -11,10 +11,11 @@ curve for export.
 
 from __future__ import annotations
 
-from camcad.fit._profile import ProfileFit, fit_points, fit_profile
+from camcad.fit._profile import fit_points, fit_profile
 from camcad.fit.bspline import clamped_from_periodic, to_geomdl
 from camcad.fit.cam import fit_cam_profile
 from camcad.fit.curve import BSplineCurve
+from camcad.fit.result import ProfileFit
 
 __all__ = [
     "BSplineCurve",

@@ -1,9 +1,10 @@
 """Tolerance-driven B-spline fit of a cam profile or any ordered point set.
 
 Public names are re-exported by :mod:`camcad.fit`. The search picks the
-smallest number of control points whose certified error (true distance from
-the samples, and from exact profile points between them, to the curve) is
-below the tolerance:
+smallest number of control points whose certified error (the largest true
+distance from the exact profile to the curve, bounded over the whole turn by
+:func:`camcad.fit.certify.certify_exact`, or from the samples when no exact
+profile is known) is below the tolerance:
 
 1. fixed knots: u = 0 and the motion breakpoints (multiplicity p − k);
 2. for a count of free knots: place them (:mod:`camcad.fit.knots`), fit by
@@ -14,9 +15,14 @@ below the tolerance:
 3. choose counts by the h^{p+1} law until one passes, then scan a window of
    smaller counts (the max error is not monotone in the count, so no
    bisection). Counts are compared on a subsample of about
-   ``SEARCH_SAMPLES`` points; the chosen one is refitted on all samples and
-   certified (:mod:`camcad.fit.certify`); if the certificate fails, the
-   search goes on.
+   ``SEARCH_SAMPLES`` points (more for programs of many segments); the chosen
+   one is refitted on all samples and certified (:mod:`camcad.fit.certify`);
+   if the certificate fails, the search goes on.
+
+The budget is the caller's ``max_control_points`` or, by default, as many
+control points as the samples leave room for (``MIN_SAMPLE_GAP`` samples
+between knots), up to ``AUTO_MAX_CONTROL_POINTS``; it scales with the
+program (more segments, more samples between breakpoints, more room).
 
 References
 ----------
@@ -39,6 +45,7 @@ import numpy as np
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import FitError
+from camcad.fit._limits import Names, limit_error
 from camcad.fit.bspline import (
     SplineFit,
     chord_length_params,
@@ -46,7 +53,7 @@ from camcad.fit.bspline import (
     lsq_clamped,
     lsq_periodic,
 )
-from camcad.fit.certify import Certificate, certify, normal_distance, seam_jumps
+from camcad.fit.certify import Certificate, ExactProfile, certify, certify_exact, normal_distance, seam_jumps
 from camcad.fit.curve import BSplineCurve
 from camcad.fit.knots import (
     MIN_SAMPLE_GAP,
@@ -57,6 +64,7 @@ from camcad.fit.knots import (
     fixed_knots,
     place_knots,
 )
+from camcad.fit.result import ProfileFit
 from camcad.fit.seam import longest_stretch, seam_parameter
 
 __all__ = ["ProfileFit", "fit_points", "fit_profile"]
@@ -66,88 +74,8 @@ REPLACEMENTS = 2  # knot placements per count (equidistribution passes); more di
 WINDOW = 3  # smaller counts that must all fail before a count is accepted
 START_SPANS = 16  # spans of the first count tried (then the h^{p+1} law)
 SEARCH_SAMPLES = 1200  # the count search runs on about this many samples
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class ProfileFit:
-    """A B-spline fitted to a profile, with its error certificate.
-
-    Attributes
-    ----------
-    curve
-        Periodic curve (closed input) or clamped open curve (open input);
-        parameter domain [0, 1] in normalised chord length.
-    clamped
-        Clamped export form of the same curve. For closed input it opens at
-        ``seam`` and its domain is [0, 1] again: ``clamped.evaluate(v)``
-        equals ``curve.evaluate(v + seam)``; and
-        ``control_points[-1] == control_points[0]``. For open input it is
-        ``curve``.
-    params
-        (n,) increasing foot-point parameter of each input sample on
-        ``curve``: the curve point nearest the sample is
-        ``curve.evaluate(params)``. For closed input the first may lie a hair
-        below 0 (its foot point precedes u = 0); ``curve`` wraps it. On
-        ``clamped`` use :attr:`clamped_params`.
-    tolerance
-        Requested tolerance [mm].
-    max_error
-        Certified max distance from the exact profile to the curve [mm]:
-        the larger of the sample and the between-sample checks.
-    rms_error
-        RMS distance of the samples to the curve [mm].
-    control_points
-        Number of control points of the clamped form.
-    degree
-        Degree p.
-    seam_tangent_jump
-        Angle between the tangents either side of the seam of the clamped
-        form [rad] (0 for open input).
-    seam_curvature_jump
-        |Δκ| across the seam of the clamped form [1/mm] (0 for open input).
-    seam
-        Parameter u_s of ``curve`` where ``clamped`` starts: inside the
-        longest stretch between motion breakpoints (:mod:`camcad.fit.seam`),
-        so the seam adds no tangent or curvature jump and the exported spline
-        does not start at a joint; 0 without breakpoints and for open input.
-    """
-
-    curve: BSplineCurve
-    clamped: BSplineCurve
-    params: FloatArray
-    tolerance: float
-    max_error: float
-    rms_error: float
-    control_points: int
-    degree: int
-    seam_tangent_jump: float
-    seam_curvature_jump: float
-    seam: float = 0.0
-
-    @property
-    def clamped_params(self) -> FloatArray:
-        """(n,) ``params`` on ``clamped``: ``np.mod(params − seam, 1)``.
-
-        ``clamped.evaluate(clamped_params)`` equals ``curve.evaluate(params)``;
-        for closed input they increase from the first sample past the seam
-        and drop by one period once.
-        """
-        if self.curve.periodic:
-            out = np.mod(np.asarray(self.params) - self.seam, 1.0)
-        else:
-            out = np.array(self.params)
-        readonly(out)
-        return out
-
-    def summary(self) -> dict[str, float | int]:
-        """Tolerance, errors [mm], control points and degree for the report."""
-        return {
-            "tolerance_mm": self.tolerance,
-            "max_error_mm": self.max_error,
-            "rms_error_mm": self.rms_error,
-            "control_points": self.control_points,
-            "degree": self.degree,
-        }
+SEARCH_SAMPLES_PER_SEGMENT = 24  # ... but at least this many per segment between breakpoints
+AUTO_MAX_CONTROL_POINTS = 2500  # default budget: a 2500² float64 normal matrix is 50 MB
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -156,11 +84,13 @@ class _Problem:
 
     params: FloatArray
     points: FloatArray
-    between: FloatArray | None
+    exact: ExactProfile | None
     fixed: FixedKnots
     degree: int
     tolerance: float
     max_control_points: int
+    automatic_budget: bool  # max_control_points is AUTO_MAX_CONTROL_POINTS, not the caller's
+    names: Names
     seam_window: tuple[float, float] | None = None  # u of the middle half of the longest stretch
 
     @property
@@ -184,11 +114,13 @@ class _Problem:
         """Smallest and largest admissible free-knot counts."""
         p = self.degree
         lo = max(0, p + 1 - self.fixed.n_fixed) if self.periodic else 0
-        hi = self.max_control_points - self.control_points(0)
+        return lo, min(self.max_control_points - self.control_points(0), self.room())
+
+    def room(self) -> int:
+        """Free knots the samples allow (``MIN_SAMPLE_GAP`` samples between neighbours)."""
         t_ext = np.append(self.params, 1.0) if self.periodic else self.params
         index = np.interp(self.fixed.edges, t_ext, np.arange(len(t_ext), dtype=float))
-        room = int(np.sum(np.maximum(np.floor(np.diff(index) / MIN_SAMPLE_GAP) - 1, 0)))
-        return lo, min(hi, room)
+        return int(np.sum(np.maximum(np.floor(np.diff(index) / MIN_SAMPLE_GAP) - 1, 0)))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -265,7 +197,7 @@ def _subsample(problem: _Problem, size: int) -> _Problem:
     idx = np.arange(0, n, stride)
     if not problem.periodic and idx[-1] != n - 1:
         idx = np.append(idx, n - 1)
-    return dataclasses.replace(problem, params=problem.params[idx], points=problem.points[idx], between=None)
+    return dataclasses.replace(problem, params=problem.params[idx], points=problem.points[idx], exact=None)
 
 
 @dataclass(slots=True)
@@ -310,12 +242,15 @@ class _Search:
         return self.finals[n_free]
 
     def certify(self, n_free: int) -> tuple[Certificate, Certificate | None]:
-        """Full certificate (foot points of samples and between-sample points)."""
+        """Full certificate: foot points of the samples, and the bound over the exact profile."""
         prob = self.problem
         trial = self.final(n_free)
         if trial.curve is None:  # only counts with a finite error are certified
             raise ValueError(f"no curve for {n_free} free knots")
-        return certify(trial.curve, prob.points, trial.params, prob.between)
+        at_samples, _ = certify(trial.curve, prob.points, trial.params)
+        if prob.exact is None:
+            return at_samples, None
+        return at_samples, certify_exact(trial.curve, prob.exact, prob.points, at_samples.foot)
 
 
 def _certified_max(certs: tuple[Certificate, Certificate | None]) -> float:
@@ -323,17 +258,11 @@ def _certified_max(certs: tuple[Certificate, Certificate | None]) -> float:
     return max(at_samples.max_error, between.max_error if between is not None else 0.0)
 
 
-def _unreachable(search: _Search) -> FitError:
-    """FitError carrying the best certified error over the tried counts."""
-    prob = search.problem
+def _best_certified(search: _Search) -> tuple[int | None, float]:
+    """(free-knot count, certified max error [mm]) of the best count tried, or (None, inf)."""
     finite = [k for k, t in search.trials.items() if t.curve is not None]
     if not finite:
-        return FitError(
-            f"no fit possible with at most {prob.max_control_points} control points "
-            f"for {len(prob.points)} samples; give more samples or raise max_control_points",
-            best_error=math.inf,
-            control_points=prob.control_points(0),
-        )
+        return None, math.inf
     best = min(finite, key=lambda k: search.error(k))
     err = search.error(best)
     if best not in search.rejected and search.final(best).curve is not None:
@@ -341,13 +270,28 @@ def _unreachable(search: _Search) -> FitError:
     if search.rejected and min(search.rejected.values()) < err:
         best = min(search.rejected, key=search.rejected.__getitem__)
         err = search.rejected[best]
-    cps = prob.control_points(best)
-    return FitError(
-        f"cannot fit within tolerance {prob.tolerance:.3g} mm using at most "
-        f"{prob.max_control_points} control points: best max error {err:.3g} mm "
-        f"with {cps} control points; raise max_control_points or relax the tolerance",
+    return best, err
+
+
+def _unreachable(search: _Search) -> FitError:
+    """FitError naming the knob that stopped the search (:func:`camcad.fit._limits.limit_error`)."""
+    prob = search.problem
+    best, err = _best_certified(search)
+    needed = None
+    if best is not None and math.isfinite(err):
+        est = estimate_free_knots(best, prob.fixed.n_segments, err, prob.tolerance, prob.degree)
+        needed = prob.control_points(est)
+    return limit_error(
+        names=prob.names,
+        tolerance=prob.tolerance,
+        n_samples=len(prob.points),
+        max_control_points=prob.max_control_points,
+        automatic_budget=prob.automatic_budget,
+        samples_bind=search.coarse.room() < prob.max_control_points - prob.control_points(0),
+        reached=prob.control_points(max(search.trials, default=0)),
+        best=None if best is None else prob.control_points(best),
         best_error=err,
-        control_points=cps,
+        needed=needed,
     )
 
 
@@ -379,8 +323,27 @@ def _next_count(search: _Search, lo: int, hi: int) -> int | None:
 
 
 def _search(problem: _Problem) -> tuple[BSplineCurve, tuple[Certificate, Certificate | None]]:
-    """Smallest certified free-knot count (see the module docstring)."""
-    search = _Search(problem, _subsample(problem, SEARCH_SAMPLES))
+    """Smallest certified free-knot count (see the module docstring).
+
+    The counts are compared on a subsample, which leaves room for fewer
+    knots than all samples: if its room stops the search, the search runs
+    again on a subsample four times larger (at last on all samples).
+    """
+    size = max(SEARCH_SAMPLES, SEARCH_SAMPLES_PER_SEGMENT * problem.fixed.n_segments)
+    budget = problem.max_control_points - problem.control_points(0)
+    while True:
+        search = _Search(problem, _subsample(problem, size))
+        try:
+            return _search_on(search)
+        except FitError:
+            if search.coarse is problem or search.coarse.room() >= min(budget, problem.room()):
+                raise
+            size *= 4
+
+
+def _search_on(search: _Search) -> tuple[BSplineCurve, tuple[Certificate, Certificate | None]]:
+    """Run one search over the counts its subsample allows."""
+    problem = search.problem
     lo, hi = search.coarse.n_free_bounds()
     if hi < lo:
         raise _unreachable(search)
@@ -392,7 +355,11 @@ def _search(problem: _Problem) -> tuple[BSplineCurve, tuple[Certificate, Certifi
             continue
         passing = sorted(k for k in search.trials if search.passes(k))
         if not passing:
-            raise _unreachable(search)
+            # the refit on all samples may pass where the subsample did not
+            best, err = _best_certified(search)
+            if best is None or best in search.rejected or err > problem.tolerance:
+                raise _unreachable(search)
+            passing = [best]
         certs = search.certify(passing[0])
         err = _certified_max(certs)
         curve = search.final(passing[0]).curve
@@ -427,12 +394,12 @@ def _result(
     )
 
 
-def _check_options(tolerance: float, max_control_points: int, degree: int) -> None:
+def _check_options(tolerance: float, max_control_points: int | None, degree: int) -> None:
     if not tolerance > 0.0:
         raise ValueError(f"tolerance must be > 0 mm, got {tolerance}")
     if degree < 1:
         raise ValueError(f"degree must be >= 1, got {degree}")
-    if max_control_points < 2 * (degree + 1):
+    if max_control_points is not None and max_control_points < 2 * (degree + 1):
         raise ValueError(
             f"max_control_points must be >= {2 * (degree + 1)} for degree {degree}, got {max_control_points}"
         )
@@ -456,7 +423,7 @@ def fit_profile(
     exact: Callable[[FloatArray], FloatArray],
     breakpoints: Sequence[tuple[float, int]] = (),
     tolerance: float = 1e-3,
-    max_control_points: int = 500,
+    max_control_points: int | None = None,
     degree: int = 3,
 ) -> ProfileFit:
     """Fit a closed cam profile with a periodic B-spline and certify its error.
@@ -469,7 +436,7 @@ def fit_profile(
         (n, 2) profile points at ``phi`` [mm], closing point not repeated.
     exact
         Exact profile: ``exact(phi)`` returns (m, 2) points [mm] at any
-        angles; evaluated once, at the n mid-angles between samples.
+        angles in [0, 2π); the certificate evaluates it wherever it needs.
     breakpoints
         ``(phi_k, k)`` pairs (or objects with ``.phi`` and ``.continuity``):
         the profile is C^k at φ_k [rad]. They become knots of multiplicity
@@ -477,7 +444,9 @@ def fit_profile(
     tolerance
         Largest allowed distance between curve and profile [mm].
     max_control_points
-        Budget for the clamped form.
+        Budget for the clamped form; None (default): automatic, as many as
+        the samples leave room for, up to ``AUTO_MAX_CONTROL_POINTS`` (a
+        memory bound on the least-squares system).
     degree
         Degree p (3: cubic).
 
@@ -491,8 +460,10 @@ def fit_profile(
     Raises
     ------
     FitError
-        The tolerance cannot be met within ``max_control_points``; carries
-        the best error reached.
+        The tolerance cannot be met within the budget; the message names
+        the binding limit (``max_control_points``, the samples ``phi`` or
+        ``tolerance``) and the count reached, and the error carries the
+        best certified error.
     ValueError
         Inconsistent input.
 
@@ -502,9 +473,11 @@ def fit_profile(
     (Quang & Hung 2015, eqs. 9–10) and one parameter correction (Hoschek
     1988), periodic basis, knots at the breakpoints, equidistributed free
     knots, foot-point certificate (Piegl & Tiller 1997, §6.1). The
-    certificate bounds the distance at the n samples and the n mid-angles;
-    the error between those 2n points is not bounded separately (it varies
-    on the scale of a knot span, about 100 samples).
+    certified error bounds the distance from the whole exact profile to
+    the curve, not only at the samples: between them it is maximised by
+    adaptive subdivision (:func:`camcad.fit.certify.certify_exact`), so it
+    holds at any sample step. The samples only feed the least squares:
+    sparse samples give a worse fit, never a wrong certificate.
 
     Examples
     --------
@@ -514,6 +487,30 @@ def fit_profile(
     >>> fit.max_error <= 1e-3, fit.seam_tangent_jump < 1e-9
     (True, True)
     """
+    return _fit_closed(
+        phi,
+        points,
+        exact=exact,
+        breakpoints=breakpoints,
+        tolerance=tolerance,
+        max_control_points=max_control_points,
+        degree=degree,
+        names=Names(samples="phi"),
+    )
+
+
+def _fit_closed(
+    phi: FloatArray,
+    points: FloatArray,
+    *,
+    exact: Callable[[FloatArray], FloatArray],
+    breakpoints: Sequence[tuple[float, int]],
+    tolerance: float,
+    max_control_points: int | None,
+    degree: int,
+    names: Names,
+) -> ProfileFit:
+    """:func:`fit_profile`, with the caller's names for its knobs in errors."""
     _check_options(tolerance, max_control_points, degree)
     pts = _check_points(points, degree)
     ang = np.asarray(phi, dtype=float)
@@ -537,18 +534,19 @@ def fit_profile(
     stretch = longest_stretch([phi_k for phi_k, _ in pairs])
     lo, hi = stretch or (0.0, 0.0)
     quarter = 0.25 * (hi - lo)  # the seam opens in the stretch's middle half (camcad.fit.seam)
-    phi_mid = np.mod(0.5 * (phi_ext[1:] + phi_ext[:-1]), TWO_PI)
-    between = np.asarray(exact(phi_mid), dtype=float)
-    if between.shape != pts.shape:
-        raise ValueError(f"exact(phi) must return shape {pts.shape}, got {between.shape}")
+    probe = np.asarray(exact(ang[:2]), dtype=float)
+    if probe.shape != (2, 2):
+        raise ValueError(f"exact(phi) must return shape (len(phi), 2), got {probe.shape} for 2 angles")
     problem = _Problem(
         params=params,
         points=pts,
-        between=between,
+        exact=ExactProfile(point=exact, phi=ang, breaks=np.array([phi_k for phi_k, _ in pairs])),
         fixed=fixed_knots(breaks, degree=degree, periodic=True),
         degree=degree,
         tolerance=tolerance,
-        max_control_points=max_control_points,
+        max_control_points=AUTO_MAX_CONTROL_POINTS if max_control_points is None else max_control_points,
+        automatic_budget=max_control_points is None,
+        names=names,
         seam_window=None if stretch is None else (u_of(lo + quarter), u_of(hi - quarter)),
     )
     return _result(problem, *_search(problem))
@@ -559,7 +557,7 @@ def fit_points(
     *,
     closed: bool,
     tolerance: float = 1e-3,
-    max_control_points: int = 500,
+    max_control_points: int | None = None,
     degree: int = 3,
 ) -> ProfileFit:
     """Fit any ordered point set, open or closed, within a tolerance.
@@ -575,7 +573,8 @@ def fit_points(
     tolerance
         Largest allowed distance from the points to the curve [mm].
     max_control_points
-        Budget for the clamped form.
+        Budget for the clamped form; None: automatic, as in
+        :func:`fit_profile`.
     degree
         Degree p.
 
@@ -588,7 +587,8 @@ def fit_points(
     Raises
     ------
     FitError
-        The tolerance cannot be met within ``max_control_points``.
+        The tolerance cannot be met within the budget (the message names
+        the binding limit and the count reached).
     """
     _check_options(tolerance, max_control_points, degree)
     pts = _check_points(points, degree)
@@ -597,10 +597,12 @@ def fit_points(
     problem = _Problem(
         params=chord_length_params(pts, closed=closed),
         points=pts,
-        between=None,
+        exact=None,
         fixed=fixed_knots((), degree=degree, periodic=closed),
         degree=degree,
         tolerance=tolerance,
-        max_control_points=max_control_points,
+        max_control_points=AUTO_MAX_CONTROL_POINTS if max_control_points is None else max_control_points,
+        automatic_budget=max_control_points is None,
+        names=Names(),
     )
     return _result(problem, *_search(problem))

@@ -2,40 +2,81 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from camcad.fit._profile import ProfileFit, fit_profile
+from camcad.fit._limits import Names, SamplesTooFewError
+from camcad.fit._profile import _fit_closed
+from camcad.fit.result import ProfileFit
 from camcad.geometry.cam import Cam
 
-__all__ = ["fit_cam_profile"]
+__all__ = ["FIT_STEP", "fit_cam_profile"]
+
+FIT_STEP = math.radians(0.1)  # rad, the coarsest sampling the fit uses
+REFINEMENTS = 3  # halvings of the step when the samples are too few for the tolerance
 
 
 def fit_cam_profile(
-    cam: Cam, *, tolerance: float = 1e-3, max_control_points: int = 500, step: float | None = None
+    cam: Cam, *, tolerance: float = 1e-3, max_control_points: int | None = None, step: float | None = None
 ) -> ProfileFit:
     """Certified B-spline of ``cam.profile`` over one turn.
 
-    Samples the exact profile at the cam's sampling step (0.1° by default,
-    breakpoints included), puts knots at the motion breakpoints, and certifies
-    the result against ``cam.profile`` between samples too.
+    Samples the exact profile (breakpoints included), puts knots at the
+    motion breakpoints, and certifies the result against ``cam.profile``
+    over the whole turn (:func:`camcad.fit.certify.certify_exact`), so the
+    certified error bounds the true distance whatever the sampling.
 
     Parameters
     ----------
     cam
         The cam.
     tolerance
-        Largest allowed distance from the exact profile [mm].
+        Largest allowed distance from the exact profile [mm]
+        (``fit.tolerance``).
     max_control_points
-        Budget for the search; beyond it :class:`~camcad.errors.FitError`.
+        Budget for the search (``fit.max_control_points``); None (default):
+        automatic, as many as the samples leave room for, up to a memory
+        bound (:data:`camcad.fit._profile.AUTO_MAX_CONTROL_POINTS`).
     step
-        Sampling step [rad]; default the cam's.
+        Sampling step of the fit's data [rad]. Default: the finer of the
+        cam's ``sample_step`` and ``FIT_STEP`` (0.1°): a coarse sample step
+        chosen for tables does not starve the least squares. With the
+        default, a tolerance that needs more control points than the
+        samples leave room for halves the step (up to ``REFINEMENTS``
+        times) before giving up.
+
+    Raises
+    ------
+    FitError
+        The tolerance cannot be met; the message names the knob that binds
+        (``fit.max_control_points`` when the budget stops the search,
+        ``fit.tolerance`` when the automatic budget or the finest sampling
+        does, ``step`` when the caller's step does), its value and the
+        control points reached. ``cam.sample_step_deg`` is never the cause:
+        the fit does not use a step coarser than 0.1°.
     """
-    phi = cam.sample_phi(step)
-    return fit_profile(
-        phi,
-        np.asarray(cam.profile(phi).point),
-        exact=lambda p: cam.profile(p).point,
-        breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
-        tolerance=tolerance,
-        max_control_points=max_control_points,
+    names = Names(
+        tolerance="fit.tolerance",
+        max_control_points="fit.max_control_points",
+        samples=None if step is None else "step",
     )
+    h = min(cam.sample_step, FIT_STEP) if step is None else step
+    for attempt in range(REFINEMENTS + 1):
+        phi = cam.sample_phi(h)
+        try:
+            return _fit_closed(
+                phi,
+                np.asarray(cam.profile(phi).point),
+                exact=lambda p: cam.profile(p).point,
+                breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
+                tolerance=tolerance,
+                max_control_points=max_control_points,
+                degree=3,
+                names=names,
+            )
+        except SamplesTooFewError:
+            if step is not None or attempt == REFINEMENTS:
+                raise
+            h *= 0.5
+    raise AssertionError("unreachable")  # pragma: no cover
