@@ -94,10 +94,22 @@ class Analysis:
 
 
 def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
-    """True peaks of |v|, |a|, |j| with their angles (one-sided at joints), the lift and the joint report."""
+    """True peaks of |v|, |a|, |j| with their angles (one-sided at joints), the lift and the joint report.
+
+    Where the velocity jumps (``velocity_jumps_deg``) the acceleration is an
+    impulse: the peaks of |a| and |j| are infinite and reported as ``None``.
+    """
     out: dict[str, Any] = {"lift_mm": cam.program.lift}
     joints = [bp.phi for bp in cam.program.breakpoints]
+    # where v jumps, a is an impulse and j is undefined: their peaks are infinite, not the samples'
+    impulses = [round(math.degrees(bp.phi), 6) for bp in cam.program.breakpoints if bp.continuity == 0]
+    out["velocity_jumps_deg"] = impulses
     for key, unit in (("v", "mm_per_rad"), ("a", "mm_per_rad2"), ("j", "mm_per_rad3")):
+        if impulses and key != "v":
+            out[f"{key}_max_abs_{unit}"] = None  # infinite at the velocity jumps
+            out[f"{key}_max_abs_angle_deg"] = impulses[0]
+            out[f"{key}_max_abs_side"] = None
+            continue
         peak = maximum(
             lambda p, side, key=key: np.abs(getattr(cam.motion(p, side=side), key)),
             motion.phi,

@@ -159,8 +159,8 @@ class JumpError(DesignLimitError):
     """The follower leaves the cam (contact force below the margin)."""
 
 
-class FitError(CamcadError):
-    """The NURBS fit cannot meet the tolerance within the control-point budget."""
+class FitError(DesignLimitError):
+    """The NURBS fit cannot meet the tolerance within the control-point budget (a hard limit)."""
 
     def __init__(self, message: str, *, best_error: float, control_points: int) -> None:
         super().__init__(message)

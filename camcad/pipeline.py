@@ -9,6 +9,7 @@ the output folder only when every stage has succeeded.
 from __future__ import annotations
 
 import math
+import re
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -206,8 +207,11 @@ def analyse(
 
 
 def _hard_finding(kind: str, field: str, err: Exception) -> Finding:
-    """A hard finding for a limit error a later stage raised (its message names the field)."""
-    return Finding(kind=kind, severity=Severity.HARD, field=getattr(err, "field", field), message=str(err))
+    """A hard finding for a limit error a later stage raised; its message starts with the field it names."""
+    named = str(err).split(":", 1)[0]
+    if re.fullmatch(r"[a-z_]+\.[a-z_]+", named):
+        field = named
+    return Finding(kind=kind, severity=Severity.HARD, field=field, message=str(err))
 
 
 def _groups(only: Iterable[str] | None) -> set[str]:
