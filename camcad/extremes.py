@@ -27,7 +27,19 @@ import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray
 
-__all__ = ["SIDE_WORDS", "Extreme", "Kind", "Quantity", "Side", "extremes", "maximum", "minimum", "side_text"]
+__all__ = [
+    "SIDE_WORDS",
+    "Extreme",
+    "Kind",
+    "Quantity",
+    "Rows",
+    "Side",
+    "extremes",
+    "extremes_rows",
+    "maximum",
+    "minimum",
+    "side_text",
+]
 
 TWO_PI = 2.0 * math.pi
 Side = Literal["left", "right"]
@@ -35,6 +47,9 @@ Side = Literal["left", "right"]
 
 Kind = Literal["min", "max"]
 """Which extreme to find."""
+
+Rows = Callable[[FloatArray, Side], ArrayLike]
+"""Several quantities at once: cam angles (n,) [rad] and a side → values (k, n)."""
 
 Quantity = Callable[[FloatArray, Side], FloatArray]
 """An exact quantity q(φ) [any unit]: cam angles (n,) [rad] and a side → values (n,).
@@ -45,6 +60,7 @@ Quantity = Callable[[FloatArray, Side], FloatArray]
 SIDE_WORDS = {"left": "before joint", "right": "after joint"}
 """How summary.json names a one-sided limit (the ``*_side`` keys)."""
 
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0  # 0.618
 _GOLDEN_SECTION = (3.0 - math.sqrt(5.0)) / 2.0  # 0.382: the golden step into the larger side
 _CONTINUOUS_RTOL = 1e-9  # one-sided limits this close are one value: no "just before the joint"
 _ITERATIONS = 60  # at most; a golden step alone shrinks a bracket by 0.618 (0.618^60 ≈ 3e-13)
@@ -98,108 +114,237 @@ class _Sequence:
     """The samples of one turn split into smooth pieces: right values on the grid, left limits at ends."""
 
     phi: FloatArray  # (m,) rad, ascending within each piece
-    value: FloatArray  # (m,)
+    value: FloatArray  # (k, m), one row per quantity
     piece: np.ndarray  # (m,) int, piece index
     left: np.ndarray  # (m,) bool, a left limit at a joint
 
 
+def _rows(values: ArrayLike, k: int) -> FloatArray:
+    out = np.asarray(values, dtype=float)
+    return out.reshape(k, -1)
+
+
 def _sequence(
-    quantity: Quantity, grid: FloatArray, joints: FloatArray, values: FloatArray | None
+    quantity: Rows, grid: FloatArray, joints: FloatArray, values: FloatArray | None, k: int
 ) -> _Sequence:
     bounds = np.union1d(np.mod(joints, TWO_PI), [0.0])
-    right = np.asarray(quantity(grid, "right") if values is None else values, dtype=float)
+    right = _rows(quantity(grid, "right") if values is None else values, k)
     missing = bounds[~np.isin(bounds, grid)]
     if missing.size:  # a joint off the grid: add its right value too
         grid = np.concatenate((grid, missing))
-        right = np.concatenate((right, np.asarray(quantity(missing, "right"), dtype=float)))
+        right = np.concatenate((right, _rows(quantity(missing, "right"), k)), axis=1)
     left_phi = np.where(bounds == 0.0, TWO_PI, bounds)
-    left = np.asarray(quantity(left_phi, "left"), dtype=float)
+    left = _rows(quantity(left_phi, "left"), k)
     piece_grid = np.searchsorted(bounds, grid, side="right") - 1
     piece_left = np.searchsorted(bounds, left_phi, side="left") - 1  # the piece that ends there
     phi = np.concatenate((grid, left_phi))
     order = np.lexsort((phi, np.concatenate((piece_grid, piece_left))))
     return _Sequence(
         phi=phi[order],
-        value=np.concatenate((right, left))[order],
+        value=np.concatenate((right, left), axis=1)[:, order],
         piece=np.concatenate((piece_grid, piece_left))[order],
         left=np.concatenate((np.zeros(grid.size, bool), np.ones(left_phi.size, bool)))[order],
     )
 
 
-def _brackets(seq: _Sequence, sign: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """(lo, mid, hi, sign·value at mid) of every non-flat local maximum of sign·value inside its piece."""
-    val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
-    m = val.size
+@dataclass(frozen=True, slots=True)
+class _Brackets:
+    """Brackets x1 < x2 < x3 [rad] of sampled maxima, with the (signed) values known there (nan: unknown)."""
+
+    row: np.ndarray
+    x1: FloatArray
+    x2: FloatArray
+    x3: FloatArray
+    f1: FloatArray
+    f2: FloatArray
+    f3: FloatArray
+
+
+def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
+    """Every sampled local maximum of each row of ``val`` (signed: maxima sought) that could beat ``best``.
+
+    Interior peaks are bracketed by their two neighbours. A peak at a piece's
+    end (a one-sided limit larger than its neighbour) gets the bracket
+    [neighbour, end] too, since the function may rise above the limit just
+    inside the piece. A peak is kept where its value plus four times its drop
+    to the lower neighbour reaches the best sample: for a smooth peak the gain
+    of the true maximum over the sample is at most a quarter of that drop, so
+    this keeps a 16-fold margin.
+    """
+    m = val.shape[1]
     same_prev = np.zeros(m, bool)
     same_prev[1:] = seq.piece[1:] == seq.piece[:-1]
     same_next = np.zeros(m, bool)
     same_next[:-1] = seq.piece[:-1] == seq.piece[1:]
-    prev_val = np.where(same_prev, np.roll(val, 1), -np.inf)
-    next_val = np.where(same_next, np.roll(val, -1), -np.inf)
-    peak = (val >= prev_val) & (val >= next_val) & np.isfinite(val)
-    flat = (~same_prev | (val == prev_val)) & (~same_next | (val == next_val))
-    idx = np.flatnonzero(peak & ~flat)
-    # interior peaks only: a peak at a piece's end is a one-sided limit (or its right value), and
-    # any maximum just inside the end is caught by the neighbouring sample's bracket
-    idx = idx[same_prev[idx] & same_next[idx]]
-    return seq.phi[idx - 1], seq.phi[idx], seq.phi[idx + 1], val[idx]
+    prev_val = np.where(same_prev, np.roll(val, 1, axis=1), -np.inf)
+    next_val = np.where(same_next, np.roll(val, -1, axis=1), -np.inf)
+    with np.errstate(invalid="ignore"):
+        peak = (val >= prev_val) & (val >= next_val) & np.isfinite(val)
+        flat = (~same_prev | (val == prev_val)) & (~same_next | (val == next_val))
+        lower = np.minimum(np.where(same_prev, prev_val, np.inf), np.where(same_next, next_val, np.inf))
+        drop = np.where(np.isfinite(lower), val - lower, np.inf)
+        promising = val + 4.0 * drop >= best[:, None]
+    rows, idx = np.nonzero(peak & ~flat & promising)
+    inner = same_prev[idx] & same_next[idx]
+    out_rows, x1, x2, x3, f1, f2, f3 = [], [], [], [], [], [], []
+    r, i = rows[inner], idx[inner]
+    out_rows.append(r)
+    x1.append(seq.phi[i - 1])
+    x2.append(seq.phi[i])
+    x3.append(seq.phi[i + 1])
+    f1.append(val[r, i - 1])
+    f2.append(val[r, i])
+    f3.append(val[r, i + 1])
+    for end_side, nb_step in ((same_prev & ~same_next, -1), (same_next & ~same_prev, 1)):
+        sel = end_side[idx] & ~inner
+        r, i = rows[sel], idx[sel]
+        j = i + nb_step
+        lo, hi = np.minimum(seq.phi[i], seq.phi[j]), np.maximum(seq.phi[i], seq.phi[j])
+        out_rows.append(r)
+        x1.append(lo)
+        x3.append(hi)
+        x2.append(lo + _GOLDEN * (hi - lo) if nb_step < 0 else hi - _GOLDEN * (hi - lo))
+        f_end, f_nb = val[r, i], val[r, j]
+        f1.append(f_nb if nb_step < 0 else f_end)
+        f3.append(f_end if nb_step < 0 else f_nb)
+        f2.append(np.full(r.size, np.nan))
+    return _Brackets(*(np.concatenate(a) for a in (out_rows, x1, x2, x3, f1, f2, f3)))
 
 
-def _refine_max(
-    quantity: Quantity, x1: FloatArray, x2: FloatArray, x3: FloatArray, f2: FloatArray, sign: float
-) -> tuple[FloatArray, FloatArray]:
-    """Maximise sign·q on every bracket x1 < x2 < x3 with q(x2) ≥ q(x1), q(x3); vectorised.
+def _refine_max(f: _Picker, b: _Brackets) -> tuple[FloatArray, FloatArray]:
+    """Maximise f on every bracket x1 < x2 < x3 (f(x2) nan: not yet known); vectorised.
 
     Safeguarded successive parabolic interpolation (Brent 1973, ch. 5): each
     step evaluates the vertex of the parabola through the three best points,
     or a golden-section point of the larger side where the vertex is unusable,
     and keeps a bracket around the best point. It converges superlinearly on
     smooth maxima, so a dozen vectorised calls take every bracket to round-off.
+    Only interior points are evaluated; the values at x1 and x3 come from the
+    samples (they may be one-sided limits at joints).
     """
-
-    def q(phi: FloatArray) -> FloatArray:
-        out = sign * np.asarray(quantity(phi, "right"), dtype=float)
-        return np.where(np.isnan(out), -np.inf, out)
-
-    a, b = x1.copy(), x3.copy()
-    x, fx = x2.copy(), f2.copy()
-    w, fw = x1.copy(), q(x1)
-    u_prev = x3.copy()
-    fv_w = q(x3)
-    v, fv = x3.copy(), fv_w
+    a, b_, x = b.x1.copy(), b.x3.copy(), b.x2.copy()
+    fx = b.f2.copy()
+    unknown = np.isnan(fx)
+    if unknown.any():
+        fx[unknown] = f(x[unknown], np.flatnonzero(unknown))
+    w, fw = b.x1.copy(), b.f1.copy()
+    v, fv = b.x3.copy(), b.f3.copy()
+    # the best of the three seeds the search
+    start = np.where(fw > fx, 1, np.where(fv > fx, 2, 0))
+    x, fx, w, fw = (np.where(start == 1, w, x), np.where(start == 1, fw, fx),
+                    np.where(start == 1, x, w), np.where(start == 1, fx, fw))  # fmt: skip
+    x, fx, v, fv = (np.where(start == 2, v, x), np.where(start == 2, fv, fx),
+                    np.where(start == 2, x, v), np.where(start == 2, fx, fv))  # fmt: skip
+    u_prev = b.x3.copy()
     live = np.ones(x.size, bool)
     for _ in range(_ITERATIONS):
-        width = b - a
+        width = b_ - a
         tol = _XTOL * np.maximum(1.0, np.abs(x))
         live &= width > 4.0 * tol
         if not live.any():
             break
-        # parabola through (v, fv), (w, fw), (x, fx): vertex u = x − ½·num/den
         with np.errstate(divide="ignore", invalid="ignore"):  # ±inf values give no parabola: nan
             r = (x - w) * (fx - fv)
             s = (x - v) * (fx - fw)
             num = (x - v) * s - (x - w) * r
             den = 2.0 * (s - r)
             u = x - num / den
-        inside = np.isfinite(u) & (u > a + tol) & (u < b - tol)
+        inside = np.isfinite(u) & (u > a + tol) & (u < b_ - tol)
         live &= ~(inside & (np.abs(u - x) <= _XSTOP))  # the parabola's vertex is the point itself
         usable = inside & (np.abs(u - x) > tol) & (np.abs(u - u_prev) > tol)  # no stalling on one point
-        golden = np.where(x - a > b - x, x - _GOLDEN_SECTION * (x - a), x + _GOLDEN_SECTION * (b - x))
+        golden = np.where(x - a > b_ - x, x - _GOLDEN_SECTION * (x - a), x + _GOLDEN_SECTION * (b_ - x))
         u = np.where(usable, u, golden)
-        u = np.where(live, u, x)
-        fu = q(u)
-        better = (fu > fx) & live
+        fu = np.full(x.size, -np.inf)
+        fu[live] = f(u[live], np.flatnonzero(live))
         # shrink the bracket around the best point
-        a = np.where(better, np.where(u < x, a, x), np.where(u < x, u, a))
-        b = np.where(better, np.where(u < x, x, b), np.where(u < x, b, u))
-        a = np.where(live, a, a)
+        better = (fu > fx) & live
+        worse = ~better & live
+        a = np.where(better & (u >= x), x, np.where(worse & (u < x), u, a))
+        b_ = np.where(better & (u < x), x, np.where(worse & (u >= x), u, b_))
         v, fv = np.where(live, w, v), np.where(live, fw, fv)
         w = np.where(live, np.where(better, x, u), w)
         fw = np.where(live, np.where(better, fx, fu), fw)
         x = np.where(better, u, x)
         fx = np.where(better, fu, fx)
-        u_prev = u
+        u_prev = np.where(live, u, u_prev)
     return x, fx
+
+
+def extremes_rows(
+    quantity: Rows,
+    grid: ArrayLike,
+    joints: Sequence[float] | ArrayLike,
+    kinds: Sequence[Kind],
+    *,
+    values: ArrayLike | None = None,
+) -> tuple[Extreme, ...]:
+    """The true extremes of several quantities at once, one per row of ``quantity``.
+
+    Parameters
+    ----------
+    quantity
+        q(φ, side) → (k, n) values: row r is the quantity whose extreme
+        ``kinds[r]`` is sought. Rows share the angles, so a stage evaluates
+        its model once per refinement step for all its quantities.
+    grid, joints
+        As for :func:`extremes`.
+    kinds
+        ``"min"`` or ``"max"`` for each row.
+    values
+        (k, n) ``quantity(grid, "right")`` if already computed.
+
+    Returns
+    -------
+    tuple[Extreme, ...]
+        One per row, in order.
+    """
+    k = len(kinds)
+    grid_a = np.asarray(grid, dtype=float)
+    seq = _sequence(
+        quantity,
+        grid_a,
+        np.asarray(joints, dtype=float).ravel(),
+        None if values is None else _rows(values, k),
+        k,
+    )
+    sign = np.array([1.0 if kind == "max" else -1.0 for kind in kinds])[:, None]
+    val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
+    top = np.argmax(val, axis=1)
+    best = val[np.arange(k), top]
+    found = [
+        Extreme(
+            value=float(seq.value[r, top[r]]),
+            phi=float(seq.phi[top[r]]),
+            side=_sample_side(seq, r, int(top[r])),
+        )
+        for r in range(k)
+    ]
+    br = _brackets(seq, val, best)
+    if br.x1.size:
+        phi_best, f_best = _refine_max(_Picker(quantity, sign[:, 0], br.row, k), br)
+        for r in range(k):
+            mine = np.flatnonzero(br.row == r)
+            if mine.size:
+                i = mine[int(np.argmax(f_best[mine]))]
+                if f_best[i] > best[r]:
+                    found[r] = Extreme(value=float(sign[r, 0] * f_best[i]), phi=float(phi_best[i]), side=None)
+    return tuple(found)
+
+
+@dataclass(frozen=True, slots=True)
+class _Picker:
+    """f(φ) for the refinement: each bracket's own row of the quantity, signed so maxima are sought."""
+
+    quantity: Rows
+    sign: FloatArray
+    row: np.ndarray
+    k: int
+
+    def __call__(self, phi: FloatArray, which: np.ndarray) -> FloatArray:
+        """sign·q_row(φ) for the brackets ``which`` (indices), at their points ``phi``; nan → −inf."""
+        rows = self.row[which]
+        out = self.sign[rows] * _rows(self.quantity(phi, "right"), self.k)[rows, np.arange(phi.size)]
+        return np.where(np.isnan(out), -np.inf, out)
 
 
 def extremes(
@@ -236,27 +381,15 @@ def extremes(
         limit at a joint, or a sample of a flat stretch, whichever is more
         extreme.
     """
-    grid_a = np.asarray(grid, dtype=float)
-    seq = _sequence(
-        quantity,
-        grid_a,
-        np.asarray(joints, dtype=float).ravel(),
-        None if values is None else np.asarray(values, dtype=float),
+    k = len(find)
+
+    def rows(phi: FloatArray, side: Side) -> FloatArray:
+        return np.broadcast_to(np.asarray(quantity(phi, side), dtype=float), (k, np.size(phi)))
+
+    stacked = (
+        None if values is None else np.broadcast_to(np.asarray(values, dtype=float), (k, np.size(values)))
     )
-    found = []
-    for kind in find:
-        sign = 1.0 if kind == "max" else -1.0
-        val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
-        k = int(np.argmax(val))
-        best = Extreme(value=float(seq.value[k]), phi=float(seq.phi[k]), side=_sample_side(seq, k))
-        lo, mid, hi, f_mid = _brackets(seq, sign)
-        if lo.size:
-            phi, f = _refine_max(quantity, lo, mid, hi, f_mid, sign)
-            i = int(np.argmax(f))
-            if f[i] > val[k]:
-                best = Extreme(value=float(sign * f[i]), phi=float(phi[i]), side=None)
-        found.append(best)
-    return tuple(found)
+    return extremes_rows(rows, grid, joints, find, values=stacked)
 
 
 def maximum(
@@ -281,13 +414,14 @@ def minimum(
     return extremes(quantity, grid, joints, values=values, find=("min",))[0]
 
 
-def _sample_side(seq: _Sequence, k: int) -> Side | None:
-    """The side of sample k: a left limit, or a right value where the left limit differs."""
+def _sample_side(seq: _Sequence, row: int, k: int) -> Side | None:
+    """The side of sample k of a row: a left limit, or a right value where the left limit differs."""
+    value = seq.value[row]
     if seq.left[k]:
         twin = np.flatnonzero((np.mod(seq.phi, TWO_PI) == seq.phi[k] % TWO_PI) & ~seq.left)
-        return None if twin.size and _same(seq.value[twin[0]], seq.value[k]) else "left"
+        return None if twin.size and _same(value[twin[0]], value[k]) else "left"
     twin = np.flatnonzero((seq.phi == (TWO_PI if seq.phi[k] == 0.0 else seq.phi[k])) & seq.left)
-    return "right" if twin.size and not _same(seq.value[twin[0]], seq.value[k]) else None
+    return "right" if twin.size and not _same(value[twin[0]], value[k]) else None
 
 
 def _same(x: float, y: float) -> bool:
