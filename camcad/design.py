@@ -296,8 +296,8 @@ MAX_LENGTH_MM = 10_000.0  # 10 m: larger than any disc cam a machine can cut
 MIN_LENGTH_MM = 1e-3  # 1 µm: the outputs write 3-4 decimals of a millimetre
 MAX_SPEED_RPM = 1e5
 MAX_FEED_MM_MIN = 1e5  # 100 m/min
-MAX_SAMPLES = 360_000  # per turn, for [cam].sample_step_deg and [tables].step_deg
-MIN_STEP_DEG = FULL_TURN_DEG / MAX_SAMPLES  # 0.001°
+MIN_SAMPLE_STEP_DEG = 0.005  # [cam].sample_step_deg: at most 72 000 samples per turn
+MIN_TABLE_STEP_DEG = 0.01  # [tables].step_deg: at most 36 000 rows per table
 MIN_CHORD_TOL_MM = 1e-4  # 0.1 µm: finer than the 4-decimal output of DXF and mesh files
 MAX_CHORD_TOL_MM = 10.0
 MIN_GCODE_TOL_MM = 5e-4  # what 4-decimal G-code coordinates can hold
@@ -350,11 +350,10 @@ def _between(lo: float, hi: float, unit: str = "", *, zero: bool = False, lo_ope
 _length = _between(MIN_LENGTH_MM, MAX_LENGTH_MM, " mm")
 _length_or_zero = _between(MIN_LENGTH_MM, MAX_LENGTH_MM, " mm", zero=True)
 _force = _between(0.0, MAX_FORCE_N, " N")
-_feed = _between(0.0, MAX_FEED_MM_MIN, " mm/min", lo_open=True)
+_feed = _between(1.0, MAX_FEED_MM_MIN, " mm/min")  # F is written with 3 decimals; F0 is an error
 _chord_tolerance = _between(MIN_CHORD_TOL_MM, MAX_CHORD_TOL_MM, " mm")
 _segment_angle = _between(MIN_SEGMENT_DEG, FULL_TURN_DEG + ANGLE_SUM_TOL_DEG, " degrees")
 _modulus = _between(MIN_MODULUS_MPA, MAX_MODULUS_MPA, " MPa")
-_SAMPLES_WHY = f" (at most {MAX_SAMPLES} samples per turn)"
 
 
 def _name(v: str) -> str | None:
@@ -388,8 +387,18 @@ def _count(lo: int, hi: int, why: str) -> Check:
     return check
 
 
-_sample_step = _below(10.0, "degrees", low=MIN_STEP_DEG, why=_SAMPLES_WHY)
-_table_step = _below(90.0, "degrees", low=MIN_STEP_DEG, why=_SAMPLES_WHY)
+_sample_step = _below(
+    10.0,
+    "degrees",
+    low=MIN_SAMPLE_STEP_DEG,
+    why=f" (at most {FULL_TURN_DEG / MIN_SAMPLE_STEP_DEG:.0f} samples per turn)",
+)
+_table_step = _below(
+    90.0,
+    "degrees",
+    low=MIN_TABLE_STEP_DEG,
+    why=f" (at most {FULL_TURN_DEG / MIN_TABLE_STEP_DEG:.0f} rows per table)",
+)
 
 
 _MESH_FORMATS = ("stl", "obj", "ply", "off", "3mf", "vtu")
@@ -483,7 +492,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "safe_height": _Rule("float", 2.0, check=_length),
         "feed": _Rule("float", 600.0, check=_feed),
         "plunge_feed": _Rule("float", 150.0, check=_feed),
-        "spindle_rpm": _Rule("float", 10000.0, check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "spindle_rpm": _Rule("float", 10000.0, check=_between(1.0, MAX_SPEED_RPM, " rpm")),
         "coolant": _Rule("bool", False),
         "mill_bore": _Rule("bool", False),
     },
