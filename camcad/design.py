@@ -646,6 +646,12 @@ def _check_program(segments: tuple[SegmentSpec, ...]) -> None:
     for i, seg in enumerate(segments):
         if seg.kind is SegmentKind.RISE:
             s += seg.lift
+            if s > MAX_LENGTH_MM:
+                raise DesignError(
+                    f"motion[{i}].lift",
+                    f"{seg.lift:g} mm takes the follower {s:g} mm above the base circle; "
+                    f"allowed: a total lift of at most {MAX_LENGTH_MM:g} mm",
+                )
         elif seg.kind is SegmentKind.RETURN:
             s -= seg.lift
             if s < -LIFT_CLOSE_TOL_MM:

@@ -220,3 +220,17 @@ def test_an_unknown_key_with_a_newline_keeps_the_message_on_one_line():
 )
 def test_the_bounds_themselves_are_allowed(where, value):
     parse_design(broken(where, value))
+
+
+def test_the_total_lift_is_bounded_where_it_is_exceeded():
+    data = copy.deepcopy(GOOD)
+    data["motion"] = [
+        {"kind": "rise", "angle": 90, "lift": 6000, "law": "cycloidal"},
+        {"kind": "rise", "angle": 90, "lift": 6000, "law": "cycloidal"},
+        {"kind": "return", "angle": 90, "lift": 6000, "law": "cycloidal"},
+        {"kind": "return", "angle": 90, "lift": 6000, "law": "cycloidal"},
+    ]
+    with pytest.raises(DesignError) as info:
+        parse_design(data)
+    assert info.value.path == "motion[1].lift"
+    assert "12000 mm above the base circle" in str(info.value)
