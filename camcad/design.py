@@ -306,6 +306,8 @@ MIN_SEGMENT_DEG = 0.01
 MAX_SEGMENTS = 360
 MAX_TABS = 100
 MAX_PASSES = 1000  # depth levels: (thickness + breakthrough) / step_down
+MAX_HELIX_TURNS = 100_000  # bore helix: one G2/G3 block per turn
+BORE_HELIX_MIN_PITCH = 0.1  # × tool diameter, the finest helix pitch the bore milling uses
 MAX_TOOL_NUMBER = 99_999
 MAX_NAME_CHARS = 200
 MAX_FORCE_N = 1e7
@@ -731,6 +733,15 @@ def _check_design(design: Design) -> None:
             f"{gc.step_down:g} mm would cut the {depth:g} mm depth (thickness + breakthrough) in "
             f"{math.ceil(depth / gc.step_down)} passes; allowed: ≥ {depth / MAX_PASSES:.4g} mm "
             f"(at most {MAX_PASSES} passes)",
+        )
+    finest_pitch = min(gc.step_down, BORE_HELIX_MIN_PITCH * gc.tool_diameter)
+    if gc.mill_bore and depth / finest_pitch > MAX_HELIX_TURNS:
+        raise DesignError(
+            "gcode.tool_diameter",
+            f"a Ø{gc.tool_diameter:g} mm tool may need up to {math.ceil(depth / finest_pitch)} helix turns "
+            f"(pitch ≥ {BORE_HELIX_MIN_PITCH:g} × tool diameter) to mill the bore {depth:g} mm deep; "
+            f"allowed: at most {MAX_HELIX_TURNS} turns, so tool_diameter ≥ "
+            f"{depth / (BORE_HELIX_MIN_PITCH * MAX_HELIX_TURNS):.6g} mm with mill_bore = true",
         )
     if gc.tab_count > 0 and gc.tab_height >= cam.thickness:
         raise DesignError(

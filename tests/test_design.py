@@ -234,3 +234,18 @@ def test_the_total_lift_is_bounded_where_it_is_exceeded():
         parse_design(data)
     assert info.value.path == "motion[1].lift"
     assert "12000 mm above the base circle" in str(info.value)
+
+
+def test_bore_helix_turns_are_bounded_through_the_tool_diameter():
+    data = broken("gcode.mill_bore", True)
+    data["gcode"].update(tool_diameter=0.001, step_down=5.0)
+    data["cam"].update(thickness=1000.0, bore=0.004)  # 1000.5 mm deep at ≥ 0.0001 mm a turn
+    with pytest.raises(DesignError) as info:
+        parse_design(data)
+    assert info.value.path == "gcode.tool_diameter"
+    assert "10005000 helix turns" in str(info.value) and "≥ 0.10005 mm" in str(
+        info.value
+    )  # 1000.5 / (0.1 × 100000)
+    data["gcode"]["tool_diameter"] = 0.1  # 1000 mm deep: exactly 100000 turns at worst
+    data["cam"]["thickness"] = 999.5
+    assert parse_design(data).gcode.tool_diameter == 0.1
