@@ -16,6 +16,7 @@ from __future__ import annotations
 import difflib
 import enum
 import math
+import numbers
 import re
 import reprlib
 import sys
@@ -359,7 +360,13 @@ _modulus = _between(MIN_MODULUS_MPA, MAX_MODULUS_MPA, " MPa")
 
 
 def _name(v: str) -> str | None:
-    return None if len(v) <= MAX_NAME_CHARS else f"is longer than {MAX_NAME_CHARS} characters"
+    if len(v) > MAX_NAME_CHARS:
+        return f"is longer than {MAX_NAME_CHARS} characters"
+    try:
+        v.encode("utf-8")
+    except UnicodeEncodeError:
+        return "is not valid Unicode text (a lone surrogate cannot be written to any file)"
+    return None
 
 
 def _fraction(v: float) -> str | None:
@@ -524,8 +531,8 @@ def _key(key: object) -> str:
     return _show(key)
 
 
-def _suggest(key: str, allowed: list[str]) -> str:
-    close = difflib.get_close_matches(key[:100], allowed, n=1, cutoff=0.6)
+def _suggest(key: object, allowed: list[str]) -> str:
+    close = difflib.get_close_matches(key[:100] if isinstance(key, str) else "", allowed, n=1, cutoff=0.6)
     hint = f"; did you mean {close[0]!r}?" if close else ""
     return f"unknown key {_show(key)}{hint} (allowed: {', '.join(allowed)})"
 
@@ -534,7 +541,7 @@ def _convert(path: str, rule: _Rule, value: Any) -> Any:
     """Convert one TOML value by its rule, or raise DesignError naming the path."""
     kind = rule.kind
     if kind == "float":
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise DesignError(path, f"expected a number, got {_show(value)}")
         try:
             out: Any = float(value)
@@ -543,9 +550,9 @@ def _convert(path: str, rule: _Rule, value: Any) -> Any:
         if not math.isfinite(out):
             raise DesignError(path, f"expected a finite number, got {_show(value)}")
     elif kind == "int":
-        if isinstance(value, bool) or not isinstance(value, int):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
             raise DesignError(path, f"expected a whole number, got {_show(value)}")
-        out = value
+        out = int(value)
     elif kind == "bool":
         if not isinstance(value, bool):
             raise DesignError(path, f"expected true or false, got {_show(value)}")

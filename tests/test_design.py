@@ -249,3 +249,16 @@ def test_bore_helix_turns_are_bounded_through_the_tool_diameter():
     data["gcode"]["tool_diameter"] = 0.1  # 1000 mm deep: exactly 100000 turns at worst
     data["cam"]["thickness"] = 999.5
     assert parse_design(data).gcode.tool_diameter == 0.1
+
+
+def test_the_python_api_accepts_numpy_numbers_and_rejects_unwritable_names():
+    np = pytest.importorskip("numpy")
+    design = parse_design(broken("gcode.tab_count", np.int64(2)))
+    assert design.gcode.tab_count == 2 and type(design.gcode.tab_count) is int
+    assert parse_design(broken("cam.base_radius", np.float32(40.0))).cam.base_radius == 40.0
+    with pytest.raises(DesignError) as info:
+        parse_design(broken("cam.name", "a\ud800b"))
+    assert info.value.path == "cam.name"
+    with pytest.raises(DesignError) as info:
+        parse_design(broken("cam.5", 1))  # a key that is not a string
+    assert info.value.path == "cam.5"
