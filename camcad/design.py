@@ -295,6 +295,8 @@ class _Rule:
 # design allocates gigabytes or runs for minutes.
 MAX_LENGTH_MM = 10_000.0  # 10 m: larger than any disc cam a machine can cut
 MIN_LENGTH_MM = 1e-3  # 1 µm: the outputs write 3-4 decimals of a millimetre
+MIN_BASE_RADIUS_MM = 0.1  # the smallest cam whose outline the default tolerances can still follow
+TOLERANCE_PER_BASE_RADIUS = 0.1  # every tolerance must be below this share of the base radius
 MAX_SPEED_RPM = 1e5
 MAX_FEED_MM_MIN = 1e5  # 100 m/min
 MIN_SAMPLE_STEP_DEG = 0.005  # [cam].sample_step_deg: at most 72 000 samples per turn
@@ -425,7 +427,9 @@ def _mesh_formats(v: list[str]) -> str | None:
 _SECTIONS: dict[str, dict[str, _Rule]] = {
     "cam": {
         "name": _Rule("str", "cam", check=_name),
-        "base_radius": _Rule("float", required=True, check=_length),
+        "base_radius": _Rule(
+            "float", required=True, check=_between(MIN_BASE_RADIUS_MM, MAX_LENGTH_MM, " mm")
+        ),
         "rotation": _Rule("enum", Rotation.CCW, enum=Rotation),
         "speed_rpm": _Rule("float", 100.0, check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
         "thickness": _Rule("float", 10.0, check=_length),
@@ -727,6 +731,19 @@ def _check_design(design: Design) -> None:
             raise DesignError("dynamics.model", "'guided-tappet' needs a translating-flat follower")
         if dyn.b_m <= dyn.a_m:
             raise DesignError("dynamics.b_m", f"{dyn.b_m:g} mm must be greater than a_m = {dyn.a_m:g} mm")
+    largest = TOLERANCE_PER_BASE_RADIUS * cam.base_radius
+    for path, tol in (
+        ("fit.tolerance", design.fit.tolerance),
+        ("dxf.chord_tolerance", design.dxf.chord_tolerance),
+        ("mesh.chord_tolerance", design.mesh.chord_tolerance),
+        ("gcode.tolerance", design.gcode.tolerance),
+    ):
+        if tol > largest:
+            raise DesignError(
+                path,
+                f"{tol:g} mm is too coarse for a base radius of {cam.base_radius:g} mm; "
+                f"allowed: ≤ {largest:g} mm ({TOLERANCE_PER_BASE_RADIUS:g} × base_radius)",
+            )
     gc = design.gcode
     if gc.safe_height >= gc.clearance_height:
         raise DesignError(
