@@ -9,6 +9,13 @@ or raises :class:`~camcad.errors.DesignError` naming the field path
 Units at this edge: lengths mm, angles degrees, speed rpm, mass kg, force N,
 torque N·mm, stress and moduli MPa. Inside the specs angles are radians; the
 attribute docstrings say which.
+
+Every number has a bounded range, so that a design that validates also
+analyses and builds in seconds: physical sizes up to a 10 m part
+(``MAX_LENGTH_MM``), speeds up to 10⁵ rpm, and resolution settings (sample
+and table steps, chord and fit tolerances, passes, tabs, helix turns) no finer
+than the outputs can use. Every text the user gives is sanitised where it is
+written (G-code comments, DXF text, HTML, plot labels), not here.
 """
 
 from __future__ import annotations
@@ -302,7 +309,7 @@ MAX_FEED_MM_MIN = 1e5  # 100 m/min
 MIN_SAMPLE_STEP_DEG = 0.005  # [cam].sample_step_deg: at most 72 000 samples per turn
 MIN_TABLE_STEP_DEG = 0.01  # [tables].step_deg: at most 36 000 rows per table
 MIN_CHORD_TOL_MM = 1e-4  # 0.1 µm: finer than the 4-decimal output of DXF and mesh files
-MAX_CHORD_TOL_MM = 10.0
+MAX_TOLERANCE_MM = 10.0
 MIN_GCODE_TOL_MM = 5e-4  # what 4-decimal G-code coordinates can hold
 MIN_FIT_TOL_MM = 1e-6  # a fit finer than this only chases rounding (1e-10 of a 10 m cam)
 MIN_SEGMENT_DEG = 0.01
@@ -356,7 +363,7 @@ _length = _between(MIN_LENGTH_MM, MAX_LENGTH_MM, " mm")
 _length_or_zero = _between(MIN_LENGTH_MM, MAX_LENGTH_MM, " mm", zero=True)
 _force = _between(0.0, MAX_FORCE_N, " N")
 _feed = _between(1.0, MAX_FEED_MM_MIN, " mm/min")  # F is written with 3 decimals; F0 is an error
-_chord_tolerance = _between(MIN_CHORD_TOL_MM, MAX_CHORD_TOL_MM, " mm")
+_chord_tolerance = _between(MIN_CHORD_TOL_MM, MAX_TOLERANCE_MM, " mm")
 _segment_angle = _between(MIN_SEGMENT_DEG, FULL_TURN_DEG + ANGLE_SUM_TOL_DEG, " degrees")
 _modulus = _between(MIN_MODULUS_MPA, MAX_MODULUS_MPA, " MPa")
 
@@ -472,7 +479,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "allowable_stress": _Rule("float", None, check=_modulus),
     },
     "fit": {
-        "tolerance": _Rule("float", 1e-3, check=_between(MIN_FIT_TOL_MM, MAX_CHORD_TOL_MM, " mm")),
+        "tolerance": _Rule("float", 1e-3, check=_between(MIN_FIT_TOL_MM, MAX_TOLERANCE_MM, " mm")),
         "max_control_points": _Rule("int", 500, check=lambda v: None if v >= 8 else "must be ≥ 8"),
     },
     "dxf": {
@@ -490,7 +497,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
     "gcode": {
         "tool_diameter": _Rule("float", 6.0, check=_length),
         "tool_number": _Rule("int", 1, check=_count(1, MAX_TOOL_NUMBER, "a tool-table number")),
-        "tolerance": _Rule("float", 0.005, check=_between(MIN_GCODE_TOL_MM, MAX_CHORD_TOL_MM, " mm")),
+        "tolerance": _Rule("float", 0.005, check=_between(MIN_GCODE_TOL_MM, MAX_TOLERANCE_MM, " mm")),
         "dialect": _Rule("enum", Dialect.LINUXCNC, enum=Dialect),
         "direction": _Rule("enum", Direction.CLIMB, enum=Direction),
         "stock_to_leave": _Rule("float", 0.2, check=_between(0.0, MAX_LENGTH_MM, " mm")),
