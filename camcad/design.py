@@ -468,7 +468,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "b_m": _Rule("float", 0.0, check=_between(0.0, MAX_LENGTH_MM, " mm")),
         "wire_diameter": _Rule("float", None, check=_length),
         "coil_diameter": _Rule("float", None, check=_length),
-        "active_coils": _Rule("float", None, check=_between(0.0, 1e4, " coils", lo_open=True)),
+        "active_coils": _Rule("float", None, check=_between(0.5, 1e4, " coils")),
         "shear_modulus": _Rule("float", None, check=_modulus),
         "preload_deflection": _Rule("float", None, check=_between(0.0, MAX_LENGTH_MM, " mm")),
         "contact_width": _Rule("float", None, check=_length),
@@ -732,6 +732,11 @@ def _check_design(design: Design) -> None:
         raise DesignError(
             f"dynamics.{missing}",
             "is required: a coil spring needs wire_diameter, coil_diameter, active_coils and shear_modulus",
+        )
+    if dyn.uses_coil_spring and dyn.wire_diameter >= dyn.coil_diameter:  # type: ignore[operator]
+        raise DesignError(
+            "dynamics.wire_diameter",
+            f"{dyn.wire_diameter:g} mm must be smaller than the mean coil diameter {dyn.coil_diameter:g} mm",
         )
     if dyn.model is DynamicsModel.GUIDED_TAPPET:
         if fol.kind is not FollowerKind.TRANSLATING_FLAT:
