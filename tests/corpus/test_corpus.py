@@ -236,3 +236,19 @@ def test_plot_text_renders_literally_in_a_legend(text):
     FigureCanvasAgg(fig).draw()  # parses any mathtext: an unbalanced '$x^{$' would raise here
     (entry,) = legend.get_texts()  # a label starting with '_' would have been left out
     assert not is_math_text(entry.get_text())  # rendered as plain text, no mathtext
+
+
+@pytest.mark.parametrize("text", HOSTILE, ids=range(len(HOSTILE)))
+def test_dxf_text_survives_a_round_trip_through_ezdxf(text, tmp_path):
+    import ezdxf
+
+    from camcad.export.dxf import dxf_text
+
+    out = dxf_text(text)
+    assert all(32 <= ord(c) < 127 for c in out)
+    assert "%%" not in out and "^" not in out and len(out) <= 250
+    doc = ezdxf.new("R2010")
+    doc.modelspace().add_text(out)
+    doc.saveas(tmp_path / "t.dxf")
+    (back,) = ezdxf.readfile(tmp_path / "t.dxf").modelspace().query("TEXT")
+    assert back.dxf.text == out  # one TEXT, read back unchanged: nothing in it was a DXF escape
