@@ -170,8 +170,8 @@ def dxf_text(text: str) -> str:
     here: ASCII only (accents dropped, other characters ``?``), every control
     character a space (a newline would end the group value and corrupt the
     file), no ``%%`` (the start of a TEXT control code such as ``%%u``
-    underline or ``%%c`` diameter), no ``^`` followed by a character (the DXF
-    caret escape for control characters), at most ``MAX_TEXT_CHARS``.
+    underline or ``%%c`` diameter), no ``^`` (the DXF caret escape for
+    control characters, ``^J``; it becomes ``'``), at most ``MAX_TEXT_CHARS``.
     """
     plain = unicodedata.normalize("NFKD", text)
     plain = "".join(c for c in plain if not unicodedata.combining(c))
