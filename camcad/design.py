@@ -623,7 +623,10 @@ def _segment(index: int, table: Any) -> SegmentSpec:
         raise DesignError(f"{path}.kind", "is required (allowed: rise, return, dwell)")
     kind = _convert(f"{path}.kind", _Rule("enum", enum=SegmentKind), kind_value)
     if "angle" not in table:
-        raise DesignError(f"{path}.angle", "is required (degrees of cam rotation, > 0)")
+        raise DesignError(
+            f"{path}.angle",
+            f"is required (degrees of cam rotation, {MIN_SEGMENT_DEG:g} to {FULL_TURN_DEG:g})",
+        )
     span = _convert(f"{path}.angle", _Rule("float", check=_segment_angle), table["angle"])
     if kind is SegmentKind.DWELL:
         for key in table:
@@ -632,7 +635,9 @@ def _segment(index: int, table: Any) -> SegmentSpec:
         return SegmentSpec(kind=kind, span=span * DEG)
     law_params = {k: v for k, v in table.items() if k not in _MOTION_KEYS}
     if "lift" not in table:
-        raise DesignError(f"{path}.lift", f"is required for a {kind.value} (mm, > 0)")
+        raise DesignError(
+            f"{path}.lift", f"is required for a {kind.value} (mm, {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g})"
+        )
     lift = _convert(f"{path}.lift", _Rule("float", check=_length), table["lift"])
     law_name = table.get("law")
     if law_name is None:
