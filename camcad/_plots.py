@@ -33,6 +33,7 @@ __all__ = [
     "FOLLOWER_ANGLES_DEG",
     "Plot",
     "compare_plots",
+    "plot_text",
     "report_plots",
 ]
 
@@ -391,6 +392,19 @@ def report_plots(analysis: Analysis) -> list[Plot]:
 # comparison figures
 
 
+def plot_text(text: str) -> str:
+    """User text (a design name) made safe for a matplotlib title, label or legend entry.
+
+    Every ``$`` is escaped so no mathtext is parsed (an unbalanced ``$x^{$``
+    would raise), control characters become spaces (no stray line breaks),
+    and a leading ``_`` gets a space before it (matplotlib leaves labels
+    starting with ``_`` out of the legend).
+    """
+    plain = "".join(" " if ord(c) < 32 or ord(c) == 127 else c for c in text)
+    plain = plain.replace("$", r"\$")
+    return " " + plain if plain.startswith("_") else plain
+
+
 def _compare_curves(analyses: Sequence[Analysis], names: Sequence[str]) -> Plot:
     fig = _figure((11.0, 10.0))
     axes = fig.subplots(3, 2, sharex=True).ravel()
@@ -406,7 +420,7 @@ def _compare_curves(analyses: Sequence[Analysis], names: Sequence[str]) -> Plot:
         for n, (analysis, name) in enumerate(zip(analyses, names, strict=True)):
             phi, values = get(analysis)
             x, y = _closed(np.degrees(np.asarray(phi)), np.asarray(values, dtype=float))
-            ax.plot(x, y, color=_COLORS[n % len(_COLORS)], linewidth=1.2, label=name)
+            ax.plot(x, y, color=_COLORS[n % len(_COLORS)], linewidth=1.2, label=plot_text(name))
         ax.axhline(0.0, **_ZERO)
         _style(ax, label, xlabel=k >= 4)
     handles, labels = axes[0].get_legend_handles_labels()
@@ -427,7 +441,7 @@ def _compare_profiles(analyses: Sequence[Analysis], names: Sequence[str]) -> Plo
         pts = np.asarray(analysis.geometry.profile.point)
         pts = np.vstack((pts, pts[:1]))
         reach = max(reach, float(np.hypot(*pts.T).max()))
-        ax.plot(pts[:, 0], pts[:, 1], color=_COLORS[n % len(_COLORS)], linewidth=1.3, label=name)
+        ax.plot(pts[:, 0], pts[:, 1], color=_COLORS[n % len(_COLORS)], linewidth=1.3, label=plot_text(name))
     ax.plot(0.0, 0.0, marker="+", color="black")
     lim = 1.1 * reach
     _plan_axes(ax, lim)

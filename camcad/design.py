@@ -9,6 +9,13 @@ or raises :class:`~camcad.errors.DesignError` naming the field path
 Units at this edge: lengths mm, angles degrees, speed rpm, mass kg, force N,
 torque N·mm, stress and moduli MPa. Inside the specs angles are radians; the
 attribute docstrings say which.
+
+Every number has a bounded range, so that a design that validates also
+analyses and builds in seconds: physical sizes up to a 10 m part
+(``MAX_LENGTH_MM``), speeds up to 10⁵ rpm, and resolution settings (sample
+and table steps, chord and fit tolerances, passes, tabs, helix turns) no finer
+than the outputs can use. Every text the user gives is sanitised where it is
+written (G-code comments, DXF text, HTML, plot labels), not here.
 """
 
 from __future__ import annotations
@@ -16,6 +23,9 @@ from __future__ import annotations
 import difflib
 import enum
 import math
+import numbers
+import re
+import reprlib
 import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
@@ -288,12 +298,85 @@ class _Rule:
     attr: str | None = None  # dataclass attribute name when it differs from the key
 
 
-def _positive(v: float) -> str | None:
-    return None if v > 0 else "must be > 0"
+# Bounds on every number the schema accepts. Physical sizes are capped at a
+# 10 m part; resolution settings at what the output can use, so that no valid
+# design allocates gigabytes or runs for minutes.
+MAX_LENGTH_MM = 10_000.0  # 10 m: larger than any disc cam a machine can cut
+MIN_LENGTH_MM = 1e-3  # 1 µm: the outputs write 3-4 decimals of a millimetre
+MIN_BASE_RADIUS_MM = 0.1  # the smallest cam whose outline the default tolerances can still follow
+TOLERANCE_PER_BASE_RADIUS = 0.1  # every tolerance must be below this share of the base radius
+MAX_SPEED_RPM = 1e5
+MAX_FEED_MM_MIN = 1e5  # 100 m/min
+MIN_SAMPLE_STEP_DEG = 0.005  # [cam].sample_step_deg: at most 72 000 samples per turn
+MIN_TABLE_STEP_DEG = 0.01  # [tables].step_deg: at most 36 000 rows per table
+MIN_CHORD_TOL_MM = 1e-4  # 0.1 µm: finer than the 4-decimal output of DXF and mesh files
+MAX_TOLERANCE_MM = 10.0
+MIN_GCODE_TOL_MM = 5e-4  # what 4-decimal G-code coordinates can hold
+MIN_FIT_TOL_MM = 1e-6  # a fit finer than this only chases rounding (1e-10 of a 10 m cam)
+MIN_SEGMENT_DEG = 0.01
+MAX_SEGMENTS = 360
+MAX_TABS = 100
+MAX_PASSES = 1000  # depth levels: (thickness + breakthrough) / step_down
+MAX_HELIX_TURNS = 100_000  # bore helix: one G2/G3 block per turn
+BORE_HELIX_MIN_PITCH = 0.1  # × tool diameter, the finest helix pitch the bore milling uses
+MAX_TOOL_NUMBER = 99_999
+MAX_NAME_CHARS = 200
+MAX_FORCE_N = 1e7
+MAX_MASS_KG = 1e4
+MAX_MODULUS_MPA = 1e7  # above diamond (1.2e6 MPa)
+MIN_MODULUS_MPA = 1e-3
 
 
-def _non_negative(v: float) -> str | None:
-    return None if v >= 0 else "must be ≥ 0"
+def _show(value: Any) -> str:
+    """A user value for a one-line message: short, no raw newline, no huge number written out."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 64:
+        return f"an integer of about {int(value.bit_length() * math.log10(2)) + 1} digits"
+    return _REPR.repr(value)
+
+
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 2, 60, 60, 6, 6
+
+
+def _between(lo: float, hi: float, unit: str = "", *, zero: bool = False, lo_open: bool = False) -> Check:
+    """Check ``lo ≤ v ≤ hi`` (``lo < v`` when ``lo_open``; also ``v == 0`` when ``zero``)."""
+    low = f"> {lo:g}" if lo_open else f"≥ {lo:g}"
+    span = f"over {lo:g} up to {hi:g}" if lo_open else f"{lo:g} to {hi:g}"
+    allowed = f"{'0, or ' if zero else ''}{span}{unit}"
+
+    def check(v: float) -> str | None:
+        if (zero and v == 0) or ((v > lo if lo_open else v >= lo) and v <= hi):
+            return None
+        if v > hi:
+            head = f"must be ≤ {hi:g}"
+        elif v <= 0 and (lo > 0 or lo_open) and not zero:
+            head = "must be > 0"
+        elif v < 0:
+            head = "must be ≥ 0"
+        else:
+            head = f"must be {low}"
+        return f"{head} (allowed: {allowed})"
+
+    return check
+
+
+_length = _between(MIN_LENGTH_MM, MAX_LENGTH_MM, " mm")
+_length_or_zero = _between(MIN_LENGTH_MM, MAX_LENGTH_MM, " mm", zero=True)
+_force = _between(0.0, MAX_FORCE_N, " N")
+_feed = _between(1.0, MAX_FEED_MM_MIN, " mm/min")  # F is written with 3 decimals; F0 is an error
+_chord_tolerance = _between(MIN_CHORD_TOL_MM, MAX_TOLERANCE_MM, " mm")
+_segment_angle = _between(MIN_SEGMENT_DEG, FULL_TURN_DEG + ANGLE_SUM_TOL_DEG, " degrees")
+_modulus = _between(MIN_MODULUS_MPA, MAX_MODULUS_MPA, " MPa")
+
+
+def _name(v: str) -> str | None:
+    if len(v) > MAX_NAME_CHARS:
+        return f"is longer than {MAX_NAME_CHARS} characters"
+    try:
+        v.encode("utf-8")
+    except UnicodeEncodeError:
+        return "is not valid Unicode text (a lone surrogate cannot be written to any file)"
+    return None
 
 
 def _fraction(v: float) -> str | None:
@@ -304,13 +387,37 @@ def _poisson(v: float) -> str | None:
     return None if 0 <= v < 0.5 else "must be in [0, 0.5)"
 
 
-def _below(limit: float, unit: str) -> Check:
+def _below(limit: float, unit: str, *, low: float = 0.0, why: str = "") -> Check:
     def check(v: float) -> str | None:
-        if not 0 < v < limit:
-            return f"must be in (0, {limit:g}) {unit}"
-        return None
+        if low and low <= v < limit:
+            return None
+        if not low and 0 < v < limit:
+            return None
+        allowed = f"[{low:g}, {limit:g})" if low else f"(0, {limit:g})"
+        return f"must be in {allowed} {unit}{why}"
 
     return check
+
+
+def _count(lo: int, hi: int, why: str) -> Check:
+    def check(v: int) -> str | None:
+        return None if lo <= v <= hi else f"must be {lo} to {hi} ({why})"
+
+    return check
+
+
+_sample_step = _below(
+    10.0,
+    "degrees",
+    low=MIN_SAMPLE_STEP_DEG,
+    why=f" (at most {FULL_TURN_DEG / MIN_SAMPLE_STEP_DEG:.0f} samples per turn)",
+)
+_table_step = _below(
+    90.0,
+    "degrees",
+    low=MIN_TABLE_STEP_DEG,
+    why=f" (at most {FULL_TURN_DEG / MIN_TABLE_STEP_DEG:.0f} rows per table)",
+)
 
 
 _MESH_FORMATS = ("stl", "obj", "ply", "off", "3mf", "vtu")
@@ -327,85 +434,89 @@ def _mesh_formats(v: list[str]) -> str | None:
 
 _SECTIONS: dict[str, dict[str, _Rule]] = {
     "cam": {
-        "name": _Rule("str", "cam"),
-        "base_radius": _Rule("float", required=True, check=_positive),
+        "name": _Rule("str", "cam", check=_name),
+        "base_radius": _Rule(
+            "float", required=True, check=_between(MIN_BASE_RADIUS_MM, MAX_LENGTH_MM, " mm")
+        ),
         "rotation": _Rule("enum", Rotation.CCW, enum=Rotation),
-        "speed_rpm": _Rule("float", 100.0, check=_positive),
-        "thickness": _Rule("float", 10.0, check=_positive),
-        "bore": _Rule("float", 0.0, check=_non_negative),
-        "keyway_width": _Rule("float", 0.0, check=_non_negative),
-        "keyway_depth": _Rule("float", 0.0, check=_non_negative),
+        "speed_rpm": _Rule("float", 100.0, check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "thickness": _Rule("float", 10.0, check=_length),
+        "bore": _Rule("float", 0.0, check=_length_or_zero),
+        "keyway_width": _Rule("float", 0.0, check=_length_or_zero),
+        "keyway_depth": _Rule("float", 0.0, check=_length_or_zero),
         "max_pressure_angle": _Rule("float", 30.0, check=_below(90.0, "degrees"), scale=DEG),
-        "min_curvature_radius": _Rule("float", None, check=_non_negative),
-        "sample_step_deg": _Rule("float", 0.1, check=_below(10.0, "degrees"), scale=DEG, attr="sample_step"),
+        "min_curvature_radius": _Rule("float", None, check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "sample_step_deg": _Rule("float", 0.1, check=_sample_step, scale=DEG, attr="sample_step"),
     },
     "follower": {
         "type": _Rule("enum", FollowerKind.TRANSLATING_ROLLER, enum=FollowerKind, attr="kind"),
-        "roller_radius": _Rule("float", 0.0, check=_non_negative),
-        "offset": _Rule("float", 0.0),
-        "face_width": _Rule("float", None, check=_positive),
-        "face_margin": _Rule("float", 1.0, check=_non_negative),
+        "roller_radius": _Rule("float", 0.0, check=_length_or_zero),
+        "offset": _Rule("float", 0.0, check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm")),
+        "face_width": _Rule("float", None, check=_length),
+        "face_margin": _Rule("float", 1.0, check=_between(0.0, MAX_LENGTH_MM, " mm")),
     },
     "dynamics": {
         "model": _Rule("enum", DynamicsModel.ENERGY, enum=DynamicsModel),
-        "follower_mass": _Rule("float", 0.0, check=_non_negative),
-        "spring_rate": _Rule("float", 0.0, check=_non_negative),
-        "spring_preload": _Rule("float", 0.0, check=_non_negative),
-        "friction_torque": _Rule("float", 0.0, check=_non_negative),
+        "follower_mass": _Rule("float", 0.0, check=_between(0.0, MAX_MASS_KG, " kg")),
+        "spring_rate": _Rule("float", 0.0, check=_between(0.0, MAX_FORCE_N, " N/mm")),
+        "spring_preload": _Rule("float", 0.0, check=_force),
+        "friction_torque": _Rule("float", 0.0, check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N·mm")),
         "gravity": _Rule("bool", True),
-        "min_contact_force": _Rule("float", 0.0, check=_non_negative),
+        "min_contact_force": _Rule("float", 0.0, check=_force),
         "f1": _Rule("float", 0.0, check=_fraction),
         "f2": _Rule("float", 0.0, check=_fraction),
         "f3": _Rule("float", 0.0, check=_fraction),
-        "a_m": _Rule("float", 0.0, check=_non_negative),
-        "b_m": _Rule("float", 0.0, check=_non_negative),
-        "wire_diameter": _Rule("float", None, check=_positive),
-        "coil_diameter": _Rule("float", None, check=_positive),
-        "active_coils": _Rule("float", None, check=_positive),
-        "shear_modulus": _Rule("float", None, check=_positive),
-        "preload_deflection": _Rule("float", None, check=_non_negative),
-        "contact_width": _Rule("float", None, check=_positive),
-        "cam_modulus": _Rule("float", 206000.0, check=_positive),
+        "a_m": _Rule("float", 0.0, check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "b_m": _Rule("float", 0.0, check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "wire_diameter": _Rule("float", None, check=_length),
+        "coil_diameter": _Rule("float", None, check=_length),
+        "active_coils": _Rule("float", None, check=_between(0.5, 1e4, " coils")),
+        "shear_modulus": _Rule("float", None, check=_modulus),
+        "preload_deflection": _Rule("float", None, check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "contact_width": _Rule("float", None, check=_length),
+        "cam_modulus": _Rule("float", 206000.0, check=_modulus),
         "cam_poisson": _Rule("float", 0.3, check=_poisson),
-        "follower_modulus": _Rule("float", 206000.0, check=_positive),
+        "follower_modulus": _Rule("float", 206000.0, check=_modulus),
         "follower_poisson": _Rule("float", 0.3, check=_poisson),
-        "allowable_stress": _Rule("float", None, check=_positive),
+        "allowable_stress": _Rule("float", None, check=_modulus),
     },
     "fit": {
-        "tolerance": _Rule("float", 1e-3, check=_positive),
-        "max_control_points": _Rule("int", None, check=lambda v: None if v >= 8 else "must be ≥ 8"),
+        "tolerance": _Rule("float", 1e-3, check=_between(MIN_FIT_TOL_MM, MAX_TOLERANCE_MM, " mm")),
+        "max_control_points": _Rule(
+            "int", None, check=lambda v: None if 8 <= v <= 100_000 else "must be in [8, 100000]"
+        ),
     },
     "dxf": {
         "pitch_curve": _Rule("bool", True),
-        "chord_tolerance": _Rule("float", 0.005, check=_positive),
+        "chord_tolerance": _Rule("float", 0.005, check=_chord_tolerance),
         "annotate": _Rule("bool", True),
     },
     "mesh": {
         "formats": _Rule("strlist", ("stl",), check=_mesh_formats),
-        "chord_tolerance": _Rule("float", 0.005, check=_positive),
+        "chord_tolerance": _Rule("float", 0.005, check=_chord_tolerance),
     },
     "tables": {
-        "step_deg": _Rule("float", 1.0, check=_below(90.0, "degrees"), scale=DEG, attr="step"),
+        "step_deg": _Rule("float", 1.0, check=_table_step, scale=DEG, attr="step"),
     },
     "gcode": {
-        "tool_diameter": _Rule("float", 6.0, check=_positive),
-        "tool_number": _Rule("int", 1, check=lambda v: None if v >= 1 else "must be ≥ 1"),
-        "tolerance": _Rule("float", 0.005, check=_positive),
+        "tool_diameter": _Rule("float", 6.0, check=_length),
+        "tool_number": _Rule("int", 1, check=_count(1, MAX_TOOL_NUMBER, "a tool-table number")),
+        "tolerance": _Rule("float", 0.005, check=_between(MIN_GCODE_TOL_MM, MAX_TOLERANCE_MM, " mm")),
         "dialect": _Rule("enum", Dialect.LINUXCNC, enum=Dialect),
         "direction": _Rule("enum", Direction.CLIMB, enum=Direction),
-        "stock_to_leave": _Rule("float", 0.2, check=_non_negative),
-        "step_down": _Rule("float", 2.0, check=_positive),
-        "breakthrough": _Rule("float", 0.5, check=_non_negative),
-        "lead_radius": _Rule("float", None, check=_positive),
-        "start_angle": _Rule("float", 0.0, scale=DEG),
-        "tab_count": _Rule("int", 0, check=lambda v: None if v >= 0 else "must be ≥ 0"),
-        "tab_width": _Rule("float", 6.0, check=_positive),
-        "tab_height": _Rule("float", 1.0, check=_positive),
-        "clearance_height": _Rule("float", 10.0, check=_positive),
-        "safe_height": _Rule("float", 2.0, check=_positive),
-        "feed": _Rule("float", 600.0, check=_positive),
-        "plunge_feed": _Rule("float", 150.0, check=_positive),
-        "spindle_rpm": _Rule("float", 10000.0, check=_positive),
+        "stock_to_leave": _Rule("float", 0.2, check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "step_down": _Rule("float", 2.0, check=_length),
+        "breakthrough": _Rule("float", 0.5, check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "lead_radius": _Rule("float", None, check=_length),
+        "start_angle": _Rule("float", 0.0, check=_between(-360.0, 360.0, " degrees"), scale=DEG),
+        "tab_count": _Rule("int", 0, check=_count(0, MAX_TABS, "tabs around one contour")),
+        "tab_width": _Rule("float", 6.0, check=_length),
+        "tab_height": _Rule("float", 1.0, check=_length),
+        "clearance_height": _Rule("float", 10.0, check=_length),
+        "safe_height": _Rule("float", 2.0, check=_length),
+        "feed": _Rule("float", 600.0, check=_feed),
+        "plunge_feed": _Rule("float", 150.0, check=_feed),
+        "spindle_rpm": _Rule("float", 10000.0, check=_between(1.0, MAX_SPEED_RPM, " rpm")),
         "coolant": _Rule("bool", False),
         "mill_bore": _Rule("bool", False),
     },
@@ -425,51 +536,65 @@ _SPEC_CLASSES: dict[str, type] = {
 _MOTION_KEYS = ("kind", "angle", "lift", "law")
 
 
-def _suggest(key: str, allowed: list[str]) -> str:
-    close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]{1,60}")
+
+
+def _key(key: object) -> str:
+    """A TOML key as it may appear in a field path: bare if it is a plain word, else quoted."""
+    if isinstance(key, str) and _BARE_KEY.fullmatch(key):
+        return key
+    return _show(key)
+
+
+def _suggest(key: object, allowed: list[str]) -> str:
+    close = difflib.get_close_matches(key[:100] if isinstance(key, str) else "", allowed, n=1, cutoff=0.6)
     hint = f"; did you mean {close[0]!r}?" if close else ""
-    return f"unknown key {key!r}{hint} (allowed: {', '.join(allowed)})"
+    return f"unknown key {_show(key)}{hint} (allowed: {', '.join(allowed)})"
 
 
 def _convert(path: str, rule: _Rule, value: Any) -> Any:
     """Convert one TOML value by its rule, or raise DesignError naming the path."""
     kind = rule.kind
     if kind == "float":
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise DesignError(path, f"expected a number, got {value!r}")
-        out: Any = float(value)
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise DesignError(path, f"expected a number, got {_show(value)}")
+        try:
+            out: Any = float(value)
+        except OverflowError:
+            out = math.inf
         if not math.isfinite(out):
-            raise DesignError(path, f"expected a finite number, got {value!r}")
+            raise DesignError(path, f"expected a finite number, got {_show(value)}")
     elif kind == "int":
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise DesignError(path, f"expected a whole number, got {value!r}")
-        out = value
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            raise DesignError(path, f"expected a whole number, got {_show(value)}")
+        out = int(value)
     elif kind == "bool":
         if not isinstance(value, bool):
-            raise DesignError(path, f"expected true or false, got {value!r}")
+            raise DesignError(path, f"expected true or false, got {_show(value)}")
         out = value
     elif kind == "str":
         if not isinstance(value, str):
-            raise DesignError(path, f"expected a string, got {value!r}")
+            raise DesignError(path, f"expected a string, got {_show(value)}")
         out = value
     elif kind == "strlist":
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-            raise DesignError(path, f"expected a list of strings, got {value!r}")
+            raise DesignError(path, f"expected a list of strings, got {_show(value)}")
         out = tuple(v.lower() for v in value)
     elif kind == "enum":
         assert rule.enum is not None
         allowed = [m.value for m in rule.enum]
         if not isinstance(value, str) or value not in allowed:
-            close = difflib.get_close_matches(str(value), allowed, n=1, cutoff=0.6)
+            word = value[:100] if isinstance(value, str) else ""
+            close = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6)
             hint = f"; did you mean {close[0]!r}?" if close else ""
-            raise DesignError(path, f"{value!r} is not allowed{hint} (allowed: {', '.join(allowed)})")
+            raise DesignError(path, f"{_show(value)} is not allowed{hint} (allowed: {', '.join(allowed)})")
         out = rule.enum(value)
     else:  # pragma: no cover - schema error
         raise AssertionError(kind)
     if rule.check is not None:
         problem = rule.check(out)
         if problem:
-            raise DesignError(path, f"{value!r} {problem}")
+            raise DesignError(path, f"{_show(value)} {problem}")
     if kind == "float":
         out *= rule.scale
     return out
@@ -478,11 +603,11 @@ def _convert(path: str, rule: _Rule, value: Any) -> Any:
 def _section(name: str, table: Any) -> dict[str, Any]:
     """Validate one table against its rules; return dataclass keyword arguments."""
     if not isinstance(table, Mapping):
-        raise DesignError(name, f"expected a table [{name}], got {table!r}")
+        raise DesignError(name, f"expected a table [{name}], got {_show(table)}")
     rules = _SECTIONS[name]
     for key in table:
         if key not in rules:
-            raise DesignError(f"{name}.{key}", _suggest(key, list(rules)))
+            raise DesignError(f"{name}.{_key(key)}", _suggest(key, list(rules)))
     kwargs: dict[str, Any] = {}
     for key, rule in rules.items():
         attr = rule.attr or key
@@ -496,33 +621,42 @@ def _section(name: str, table: Any) -> dict[str, Any]:
 def _segment(index: int, table: Any) -> SegmentSpec:
     path = f"motion[{index}]"
     if not isinstance(table, Mapping):
-        raise DesignError(path, f"expected a table, got {table!r}")
+        raise DesignError(path, f"expected a table, got {_show(table)}")
     kind_value = table.get("kind")
     if kind_value is None:
         raise DesignError(f"{path}.kind", "is required (allowed: rise, return, dwell)")
     kind = _convert(f"{path}.kind", _Rule("enum", enum=SegmentKind), kind_value)
     if "angle" not in table:
-        raise DesignError(f"{path}.angle", "is required (degrees of cam rotation, > 0)")
-    span = _convert(f"{path}.angle", _Rule("float", check=_below(360.0 + 1e-9, "degrees")), table["angle"])
+        raise DesignError(
+            f"{path}.angle",
+            f"is required (degrees of cam rotation, {MIN_SEGMENT_DEG:g} to {FULL_TURN_DEG:g})",
+        )
+    span = _convert(f"{path}.angle", _Rule("float", check=_segment_angle), table["angle"])
     if kind is SegmentKind.DWELL:
         for key in table:
             if key not in ("kind", "angle"):
-                raise DesignError(f"{path}.{key}", _suggest(key, ["kind", "angle"]) + " for a dwell")
+                raise DesignError(f"{path}.{_key(key)}", _suggest(key, ["kind", "angle"]) + " for a dwell")
         return SegmentSpec(kind=kind, span=span * DEG)
     law_params = {k: v for k, v in table.items() if k not in _MOTION_KEYS}
     if "lift" not in table:
-        raise DesignError(f"{path}.lift", f"is required for a {kind.value} (mm, > 0)")
-    lift = _convert(f"{path}.lift", _Rule("float", check=_positive), table["lift"])
+        raise DesignError(
+            f"{path}.lift", f"is required for a {kind.value} (mm, {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g})"
+        )
+    lift = _convert(f"{path}.lift", _Rule("float", check=_length), table["lift"])
     law_name = table.get("law")
     if law_name is None:
         raise DesignError(f"{path}.law", f"is required for a {kind.value} (allowed: {', '.join(LAWS)})")
     if not isinstance(law_name, str):
-        raise DesignError(f"{path}.law", f"expected a law name, got {law_name!r}")
+        raise DesignError(f"{path}.law", f"expected a law name, got {_show(law_name)}")
     if law_name in LAWS:
         allowed_keys = list(_MOTION_KEYS) + [p.name for p in LAWS[law_name].parameters]
         for key in law_params:
             if key not in allowed_keys:
-                raise DesignError(f"{path}.{key}", _suggest(key, allowed_keys))
+                raise DesignError(f"{path}.{_key(key)}", _suggest(key, allowed_keys))
+        for p in LAWS[law_name].parameters:
+            value = law_params.get(p.name)
+            if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2**53:
+                raise DesignError(f"{path}.{p.name}", f"{_show(value)} is out of range; allowed: {p.allowed}")
     try:
         law = make_law(law_name, **law_params)
     except DesignError as err:
@@ -541,6 +675,12 @@ def _check_program(segments: tuple[SegmentSpec, ...]) -> None:
     for i, seg in enumerate(segments):
         if seg.kind is SegmentKind.RISE:
             s += seg.lift
+            if s > MAX_LENGTH_MM:
+                raise DesignError(
+                    f"motion[{i}].lift",
+                    f"{seg.lift:g} mm takes the follower {s:g} mm above the base circle; "
+                    f"allowed: a total lift of at most {MAX_LENGTH_MM:g} mm",
+                )
         elif seg.kind is SegmentKind.RETURN:
             s -= seg.lift
             if s < -LIFT_CLOSE_TOL_MM:
@@ -562,7 +702,8 @@ def _check_design(design: Design) -> None:
         if fol.roller_radius <= 0:
             raise DesignError(
                 "follower.roller_radius",
-                f"{fol.roller_radius:g} must be > 0 for a translating-roller follower",
+                f"{fol.roller_radius:g} must be > 0 for a translating-roller follower "
+                f"(allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
             )
         if abs(fol.offset) >= cam.base_radius + fol.roller_radius:
             raise DesignError(
@@ -570,38 +711,87 @@ def _check_design(design: Design) -> None:
                 f"|{fol.offset:g}| must be smaller than base_radius + roller_radius = "
                 f"{cam.base_radius + fol.roller_radius:g} mm",
             )
-    bore_reach = cam.bore / 2.0 + (cam.keyway_depth if cam.keyway_width else 0.0)
-    if bore_reach >= cam.base_radius:
+    if cam.bore / 2.0 >= cam.base_radius:
         raise DesignError(
             "cam.bore",
-            f"bore {cam.bore:g} mm (with keyway reaching {bore_reach:g} mm) must stay inside the "
-            f"base circle of radius {cam.base_radius:g} mm",
+            f"{cam.bore:g} mm must fit inside the base circle; allowed: < {2.0 * cam.base_radius:g} mm "
+            f"(twice base_radius)",
         )
     if (cam.keyway_width > 0) != (cam.keyway_depth > 0):
-        raise DesignError("cam.keyway_width", "keyway_width and keyway_depth must both be > 0 or both 0")
+        missing = "cam.keyway_depth" if cam.keyway_width > 0 else "cam.keyway_width"
+        raise DesignError(missing, "keyway_width and keyway_depth must both be > 0 or both 0")
     if cam.keyway_width > 0 and cam.bore <= 0:
         raise DesignError("cam.keyway_width", "a keyway needs a bore (cam.bore > 0)")
     if cam.keyway_width >= cam.bore > 0:
         raise DesignError(
             "cam.keyway_width", f"{cam.keyway_width:g} mm must be narrower than the bore {cam.bore:g} mm"
         )
+    bore_reach = cam.bore / 2.0 + cam.keyway_depth
+    if cam.keyway_width > 0 and bore_reach >= cam.base_radius:
+        raise DesignError(
+            "cam.keyway_depth",
+            f"{cam.keyway_depth:g} mm takes the keyway to radius {bore_reach:g} mm, outside the base "
+            f"circle of radius {cam.base_radius:g} mm; allowed: < {cam.base_radius - cam.bore / 2.0:g} mm",
+        )
     dyn = design.dynamics
     coil = (dyn.wire_diameter, dyn.coil_diameter, dyn.active_coils, dyn.shear_modulus)
     if any(v is not None for v in coil) and any(v is None for v in coil):
+        names = ("wire_diameter", "coil_diameter", "active_coils", "shear_modulus")
+        missing = next(n for n, v in zip(names, coil, strict=True) if v is None)
+        raise DesignError(
+            f"dynamics.{missing}",
+            "is required: a coil spring needs wire_diameter, coil_diameter, active_coils and shear_modulus",
+        )
+    if dyn.uses_coil_spring and dyn.wire_diameter >= dyn.coil_diameter:  # type: ignore[operator]
         raise DesignError(
             "dynamics.wire_diameter",
-            "a coil spring needs all of wire_diameter, coil_diameter, active_coils, shear_modulus",
+            f"{dyn.wire_diameter:g} mm must be smaller than the mean coil diameter {dyn.coil_diameter:g} mm",
         )
     if dyn.model is DynamicsModel.GUIDED_TAPPET:
         if fol.kind is not FollowerKind.TRANSLATING_FLAT:
             raise DesignError("dynamics.model", "'guided-tappet' needs a translating-flat follower")
         if dyn.b_m <= dyn.a_m:
             raise DesignError("dynamics.b_m", f"{dyn.b_m:g} mm must be greater than a_m = {dyn.a_m:g} mm")
+    largest = TOLERANCE_PER_BASE_RADIUS * cam.base_radius
+    for path, tol in (
+        ("fit.tolerance", design.fit.tolerance),
+        ("dxf.chord_tolerance", design.dxf.chord_tolerance),
+        ("mesh.chord_tolerance", design.mesh.chord_tolerance),
+        ("gcode.tolerance", design.gcode.tolerance),
+    ):
+        if tol > largest:
+            raise DesignError(
+                path,
+                f"{tol:g} mm is too coarse for a base radius of {cam.base_radius:g} mm; "
+                f"allowed: ≤ {largest:g} mm ({TOLERANCE_PER_BASE_RADIUS:g} × base_radius)",
+            )
     gc = design.gcode
     if gc.safe_height >= gc.clearance_height:
         raise DesignError(
             "gcode.safe_height",
             f"{gc.safe_height:g} mm must be below clearance_height {gc.clearance_height:g} mm",
+        )
+    depth = cam.thickness + gc.breakthrough
+    if depth / gc.step_down > MAX_PASSES:
+        raise DesignError(
+            "gcode.step_down",
+            f"{gc.step_down:g} mm would cut the {depth:g} mm depth (thickness + breakthrough) in "
+            f"{math.ceil(depth / gc.step_down)} passes; allowed: ≥ {depth / MAX_PASSES:.4g} mm "
+            f"(at most {MAX_PASSES} passes)",
+        )
+    finest_pitch = min(gc.step_down, BORE_HELIX_MIN_PITCH * gc.tool_diameter)
+    if gc.mill_bore and depth / finest_pitch > MAX_HELIX_TURNS:
+        raise DesignError(
+            "gcode.tool_diameter",
+            f"a Ø{gc.tool_diameter:g} mm tool may need up to {math.ceil(depth / finest_pitch)} helix turns "
+            f"(pitch ≥ {BORE_HELIX_MIN_PITCH:g} × tool diameter) to mill the bore {depth:g} mm deep; "
+            f"allowed: at most {MAX_HELIX_TURNS} turns, so tool_diameter ≥ "
+            f"{depth / (BORE_HELIX_MIN_PITCH * MAX_HELIX_TURNS):.6g} mm with mill_bore = true",
+        )
+    if gc.tab_count > 0 and gc.tab_height >= cam.thickness:
+        raise DesignError(
+            "gcode.tab_height",
+            f"{gc.tab_height:g} mm must be below the plate thickness {cam.thickness:g} mm",
         )
 
 
@@ -616,15 +806,25 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
     allowed = ["cam", "follower", "motion", *[s for s in _SECTIONS if s not in ("cam", "follower")]]
     for key in data:
         if key not in allowed:
-            raise DesignError(key, _suggest(key, allowed))
+            raise DesignError(_key(key), _suggest(key, allowed))
     if "cam" not in data:
         raise DesignError("cam", "the [cam] table is required")
     specs: dict[str, Any] = {}
     for name, cls in _SPEC_CLASSES.items():
         specs[name] = cls(**_section(name, data.get(name, {})))
+    follower = specs["follower"]
+    if follower.kind is FollowerKind.TRANSLATING_ROLLER and "roller_radius" not in data.get("follower", {}):
+        raise DesignError(
+            "follower.roller_radius",
+            f"is required for a translating-roller follower (mm, {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g})",
+        )
     raw_motion = data.get("motion")
     if not isinstance(raw_motion, list):
         raise DesignError("motion", "expected one or more [[motion]] tables")
+    if len(raw_motion) > MAX_SEGMENTS:
+        raise DesignError(
+            "motion", f"{len(raw_motion)} segments; allowed: at most {MAX_SEGMENTS} [[motion]] tables"
+        )
     motion = tuple(_segment(i, seg) for i, seg in enumerate(raw_motion))
     _check_program(motion)
     design = Design(motion=motion, source=source, **specs)
@@ -651,4 +851,70 @@ def load_design(path: str | Path) -> Design:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise DesignError("", f"{path} is not valid TOML: {err}") from None
+    except RecursionError:
+        where = _find_value(text, lambda v: _nesting(v)[0] > MAX_NESTING)
+        raise DesignError(
+            where, f"arrays or inline tables nested too deep to read; allowed: at most {MAX_NESTING} levels"
+        ) from None
+    except ValueError as err:  # Python's limit on the digits of one integer
+        where = _find_value(text, lambda v: re.search(rf"\d{{{_MAX_DIGITS}}}", v) is not None)
+        raise DesignError(where, f"a number too long to read: {err}".split("; use")[0]) from None
     return parse_design(data, source=str(path))
+
+
+MAX_NESTING = 100
+_MAX_DIGITS = 4300  # sys.get_int_max_str_digits() default
+
+
+def _nesting(value: str) -> tuple[int, int]:
+    """Deepest and final bracket nesting of TOML value text; strings and comments are skipped."""
+    depth = deepest = 0
+    quote = ""
+    i = 0
+    while i < len(value):
+        c = value[i]
+        if quote:
+            if c == "\\" and quote == '"':
+                i += 1
+            elif c == quote:
+                quote = ""
+        elif c in "\"'":
+            quote = c
+        elif c in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif c in "]}":
+            depth -= 1
+        elif c == "#":
+            nl = value.find("\n", i)
+            i = len(value) if nl < 0 else nl
+        i += 1
+    return deepest, depth
+
+
+def _find_value(text: str, bad: Callable[[str], bool]) -> str:
+    """The field path (``cam.name``) of the first value whose text makes ``bad`` true, or ``""``.
+
+    A line-based reading of the TOML structure, good enough to name the field
+    in a file that the TOML parser itself cannot read.
+    """
+    table, motion, key, value = "", -1, "", ""
+    for line in text.splitlines():
+        stripped = line.strip()
+        if key:
+            value += "\n" + line
+        elif stripped.startswith("["):
+            name = stripped.split("#")[0].strip().strip("[]").strip()
+            motion += stripped.startswith("[[") and name == "motion"
+            table = f"motion[{motion}]" if name == "motion" else name
+            continue
+        elif "=" in stripped and not stripped.startswith("#"):
+            raw, _, value = stripped.partition("=")
+            key = _key(raw.strip().strip("\"'"))
+        else:
+            continue
+        if _nesting(value)[1] <= 0:
+            if bad(value):
+                return f"{table}.{key}" if table else key
+            key = ""
+    return (f"{table}.{key}" if table else key) if key and bad(value) else ""

@@ -89,8 +89,11 @@ footer { margin-top: 30px; color: var(--muted); font-size: 12px; }
 
 
 def _e(text: object) -> str:
-    """Escaped text."""
-    return html.escape(str(text), quote=True)
+    """Text escaped for HTML (element content and quoted attributes); control characters become U+FFFD."""
+    plain = "".join(
+        "\ufffd" if (ord(c) < 32 and c not in "\t\n\r") or ord(c) == 127 else c for c in str(text)
+    )
+    return html.escape(plain, quote=True)
 
 
 def _num(value: Any, spec: str = ".6g") -> str:

@@ -33,6 +33,8 @@ from __future__ import annotations
 
 import math
 import os
+import re
+import unicodedata
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
@@ -57,6 +59,7 @@ if TYPE_CHECKING:
 __all__ = [
     "DXF_VERSION",
     "LAYERS",
+    "dxf_text",
     "profile_document",
     "profile_poly_document",
     "write_profile_dxf",
@@ -160,6 +163,30 @@ def _add_center_lines(msp: Modelspace, reach: float) -> None:
         msp.add_line(start, end, dxfattribs={"layer": "CENTER"})
 
 
+MAX_TEXT_CHARS = 250  # a DXF string value holds at most 255 characters in R12-era readers
+
+
+def dxf_text(text: str) -> str:
+    """Text made safe for one DXF TEXT entity.
+
+    Every user text that reaches the drawing (the cam name) goes through
+    here: ASCII only (accents dropped, other characters ``?``), every control
+    character a space (a newline would end the group value and corrupt the
+    file), no ``%%`` (the start of a TEXT control code such as ``%%u``
+    underline or ``%%c`` diameter), no ``^`` (the DXF caret escape for
+    control characters, ``^J``; it becomes ``'``), at most ``MAX_TEXT_CHARS``.
+    """
+    plain = unicodedata.normalize("NFKD", text)
+    plain = "".join(c for c in plain if not unicodedata.combining(c))
+    plain = plain.encode("ascii", "replace").decode("ascii")
+    plain = "".join(" " if ord(c) < 32 or ord(c) == 127 else c for c in plain)
+    plain = " ".join(plain.split())
+    plain = re.sub(r"%{2,}", "%", plain).replace("^", "'")
+    if len(plain) > MAX_TEXT_CHARS:
+        plain = plain[: MAX_TEXT_CHARS - 3] + "..."
+    return plain
+
+
 def _annotation_lines(design: Design, fit: _Fit) -> list[str]:
     """Plain-ASCII lines of the annotation block."""
     cam, follower = design.cam, design.follower
@@ -188,7 +215,7 @@ def _annotation_lines(design: Design, fit: _Fit) -> list[str]:
             lines.append(f"{seg.kind.value} {span}, lift {seg.lift:.3f} mm, {seg.law.describe()}")
     lines.append(f"profile spline: fit tolerance {fit.tolerance:.4g} mm, max error {fit.max_error:.3g} mm")
     lines.append("units mm")
-    return [line.encode("ascii", "replace").decode("ascii") for line in lines]
+    return [dxf_text(line) for line in lines]
 
 
 def _add_annotation(msp: Modelspace, lines: list[str], reach: float) -> float:

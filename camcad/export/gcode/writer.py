@@ -7,6 +7,7 @@ order, axis words only when they change, the feed only when it changes.
 from __future__ import annotations
 
 import math
+import re
 import unicodedata
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
@@ -19,7 +20,7 @@ if TYPE_CHECKING:
     from camcad.export.gcode.toolpath import Toolpath
     from camcad.geometry.cam import Cam
 
-__all__ = ["GcodeSummary", "count_blocks", "render_gcode", "summarize", "write_gcode"]
+__all__ = ["GcodeSummary", "comment_text", "count_blocks", "render_gcode", "summarize", "write_gcode"]
 
 
 def _num(v: float) -> str:
@@ -31,11 +32,35 @@ def _feed(v: float) -> str:
     return f"{v:.3f}".rstrip("0").rstrip(".")
 
 
-def _comment(text: str) -> str:
-    """One comment block: ASCII only, no parentheses inside."""
+MAX_COMMENT_CHARS = 200  # LinuxCNC reads lines of up to 255 characters
+# LinuxCNC acts on comments that start with these words and a comma: (MSG, …), (DEBUG, …), …
+_ACTIVE_COMMENT = re.compile(r"\s*(msg|debug|print|log\w*|probe\w*|abort)\s*,", re.IGNORECASE)
+
+
+def comment_text(text: str) -> str:
+    """Text made safe for the inside of one G-code comment.
+
+    Every text that reaches a comment (the cam name, notes) goes through
+    here: ASCII only (accents dropped), every control character (newline,
+    carriage return, tab, …) a space, no parentheses (they would close the
+    comment early) nor semicolons (a line comment in GRBL and others), at
+    most ``MAX_COMMENT_CHARS`` characters, and never a LinuxCNC active
+    comment such as ``MSG,`` at the start.
+    """
     plain = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")
+    plain = "".join(" " if ord(c) < 32 or ord(c) == 127 else c for c in plain)
     plain = plain.replace("(", "[").replace(")", "]").replace(";", ",")
-    return f"({plain.strip()})"
+    plain = " ".join(plain.split())
+    if len(plain) > MAX_COMMENT_CHARS:
+        plain = plain[: MAX_COMMENT_CHARS - 3] + "..."
+    if _ACTIVE_COMMENT.match(plain):
+        plain = "- " + plain
+    return plain
+
+
+def _comment(text: str) -> str:
+    """One whole-line comment block around :func:`comment_text`."""
+    return f"({comment_text(text)})"
 
 
 def _header(tp: Toolpath, dialect: str) -> list[str]:
