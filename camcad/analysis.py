@@ -13,10 +13,11 @@ from typing import Any
 
 import numpy as np
 
+from camcad._typing import FloatArray
 from camcad._version import __version__
 from camcad.design import Design
 from camcad.dynamics import DynamicsResult
-from camcad.extremes import SIDE_WORDS, maximum
+from camcad.extremes import SIDE_WORDS, Side, extremes_rows
 from camcad.findings import Finding
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
@@ -104,18 +105,21 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
     # where v jumps, a is an impulse and j is undefined: their peaks are infinite, not the samples'
     impulses = [round(math.degrees(bp.phi), 6) for bp in cam.program.breakpoints if bp.continuity == 0]
     out["velocity_jumps_deg"] = impulses
-    for key, unit in (("v", "mm_per_rad"), ("a", "mm_per_rad2"), ("j", "mm_per_rad3")):
+
+    def rows(p: FloatArray, side: Side) -> FloatArray:
+        m = cam.motion(p, side=side)
+        return np.abs(np.vstack((m.v, m.a, m.j)))
+
+    values = np.abs(np.vstack((motion.v, motion.a, motion.j)))
+    peaks = extremes_rows(rows, motion.phi, joints, ("max", "max", "max"), values=values)
+    for (key, unit), peak in zip(
+        (("v", "mm_per_rad"), ("a", "mm_per_rad2"), ("j", "mm_per_rad3")), peaks, strict=True
+    ):
         if impulses and key != "v":
             out[f"{key}_max_abs_{unit}"] = None  # infinite at the velocity jumps
             out[f"{key}_max_abs_angle_deg"] = impulses[0]
             out[f"{key}_max_abs_side"] = None
             continue
-        peak = maximum(
-            lambda p, side, key=key: np.abs(getattr(cam.motion(p, side=side), key)),
-            motion.phi,
-            joints,
-            values=np.abs(getattr(motion, key)),
-        )
         out[f"{key}_max_abs_{unit}"] = peak.value
         out[f"{key}_max_abs_angle_deg"] = peak.angle_deg
         out[f"{key}_max_abs_side"] = None if peak.side is None else SIDE_WORDS[peak.side]

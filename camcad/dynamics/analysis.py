@@ -22,7 +22,7 @@ from camcad.dynamics.jump import covering_arc, loss_runs, speed_window
 from camcad.dynamics.results import DynamicsResult
 from camcad.dynamics.spring import spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, tappet_forces
-from camcad.extremes import Extreme, Kind, Quantity, Side, extremes
+from camcad.extremes import Extreme, Kind, Side, extremes_rows
 from camcad.findings import Finding, Severity
 
 if TYPE_CHECKING:
@@ -33,6 +33,8 @@ if TYPE_CHECKING:
 __all__ = ["analyse_dynamics"]
 
 _RAD_S_TO_RPM = 60.0 / (2.0 * math.pi)
+# the extremes analyse_dynamics reports, one per row of its quantity
+_KINDS: tuple[Kind, ...] = ("min", "max", "min", "max", "max", "max", "max", "min", "max")
 TWO_PI = 2.0 * math.pi
 # Warn when a guide force changes side and its misdirected friction exceeds this share of N1.
 _GUIDE_FLIP_RTOL = 0.01
@@ -215,30 +217,45 @@ def analyse_dynamics(
     margin = dyn.min_contact_force
     spring_preload = spring_from_spec(dyn).preload
 
-    def exact(quantity: Callable[[_Pointwise], FloatArray]) -> Quantity:
-        assert cam is not None
+    def rows(r: _Pointwise) -> FloatArray:
+        """Every quantity whose extreme is reported, one row each (kinds in ``_KINDS``)."""
+        need_speed = margin * r.ratio - r.static  # A·ω² ≥ margin·c − B bounds ω² (jump.speed_limits)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = need_speed / r.inertia
+        return np.vstack(
+            (
+                r.force,
+                r.force,
+                r.torque,
+                r.torque,
+                r.stress,
+                # F0* = max(margin·c − A·ω² − (B − F0)) (jump.min_preload, at the true maximum)
+                margin * r.ratio - r.inertia * omega**2 - (r.static - spring_preload),
+                np.where(r.inertia == 0.0, need_speed, -np.inf),  # where A = 0, B ≥ margin·c is needed
+                np.where(r.inertia < 0.0, bound, np.inf),  # ω² ≤ min over A < 0
+                np.where(r.inertia > 0.0, bound, -np.inf),  # ω² ≥ max over A > 0
+            )
+        )
 
-        def q(p: FloatArray, side: Side) -> FloatArray:
-            m = cam.motion(p, side=side)
-            return quantity(model(m, cam.pressure_angle(p, side=side), cam.profile(p, side=side).rho))
+    values = rows(sampled)
+    if cam is None:
+        found = tuple(_sampled_extreme(phi, row, kind) for row, kind in zip(values, _KINDS, strict=True))
+    else:
+        exact = cam
 
-        return q
+        def quantity(p: FloatArray, side: Side) -> FloatArray:
+            st = exact.state(p, side=side)
+            return rows(model(st.motion, st.pressure_angle, st.profile.rho))
 
-    def find(quantity: Callable[[_Pointwise], FloatArray], *kinds: Kind) -> tuple[Extreme, ...]:
-        values = quantity(sampled)
-        if cam is None:
-            return tuple(_sampled_extreme(phi, values, kind) for kind in kinds)
         joints = [bp.phi for bp in cam.program.breakpoints]
-        return extremes(exact(quantity), phi, joints, values=values, find=kinds)
-
-    force_min, force_max = find(lambda r: r.force, "min", "max")
-    torque_min, torque_max = find(lambda r: r.torque, "min", "max")
-    (stress_max,) = find(lambda r: r.stress, "max")
-    # F0* = max(margin·c − A·ω² − (B − F0)) (camcad.dynamics.jump.min_preload, at the true maximum)
-    (need,) = find(lambda r: margin * r.ratio - r.inertia * omega**2 - (r.static - spring_preload), "max")
+        found = extremes_rows(quantity, phi, joints, _KINDS, values=values)
+    force_min, force_max, torque_min, torque_max, stress_max, need, flat_need, upper, lower = found
     preload = max(0.0, need.value)
     deflection = preload / _rate(dyn) if dyn.uses_coil_spring and _rate(dyn) > 0.0 else None
-    speeds = _speed_range(find, margin)
+    speeds = None
+    if flat_need.value <= 0.0:
+        window = speed_window(max(lower.value, 0.0), upper.value)
+        speeds = None if window is None else (window[0] * _RAD_S_TO_RPM, window[1] * _RAD_S_TO_RPM)
 
     warnings: list[str] = []
     if sampled.near is not None and sampled.far is not None:
@@ -337,25 +354,3 @@ def _sampled_extreme(phi: FloatArray, values: FloatArray, kind: Kind) -> Extreme
     """The extreme of the samples alone (when no exact cam is given)."""
     i = int(np.argmax(values) if kind == "max" else np.argmin(values))
     return Extreme(value=float(values[i]), phi=float(phi[i]))
-
-
-def _speed_range(find: Callable[..., tuple[Extreme, ...]], margin: float) -> tuple[float, float] | None:
-    """(low, high) cam speeds [rpm] keeping C ≥ margin, from true extremes (jump.speed_limits' closed form).
-
-    Each angle bounds ω² by (margin·c − B)/A: from above where A < 0, from
-    below where A > 0; where A = 0 it needs B ≥ margin·c.
-    """
-
-    def bound(r: _Pointwise, sign: float) -> FloatArray:
-        need = margin * r.ratio - r.static
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out = need / r.inertia
-        return np.where(sign * r.inertia > 0.0, out, -sign * np.inf)
-
-    (flat_need,) = find(lambda r: np.where(r.inertia == 0.0, margin * r.ratio - r.static, -np.inf), "max")
-    if flat_need.value > 0.0:
-        return None
-    (upper,) = find(lambda r: bound(r, -1.0), "min")  # ω² ≤ min over A < 0
-    (lower,) = find(lambda r: bound(r, 1.0), "max")  # ω² ≥ max over A > 0
-    window = speed_window(max(lower.value, 0.0), upper.value)
-    return None if window is None else (window[0] * _RAD_S_TO_RPM, window[1] * _RAD_S_TO_RPM)

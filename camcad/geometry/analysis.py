@@ -12,7 +12,7 @@ from scipy.optimize import brentq
 from camcad._typing import FloatArray, readonly
 from camcad.angles import flagged_ranges, format_ranges
 from camcad.errors import UndercutError
-from camcad.extremes import SIDE_WORDS, Extreme, Quantity, Side, extremes, maximum, minimum
+from camcad.extremes import SIDE_WORDS, Extreme, Kind, Quantity, Side, extremes_rows
 from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
@@ -181,24 +181,28 @@ def analyse_geometry(
     phi = cam.sample_phi(step)
     h = float(np.max(np.diff(phi)))
     joints = [bp.phi for bp in cam.program.breakpoints]
-    motion = cam.motion(phi)
-    pitch = cam.pitch(phi)
-    profile = cam.profile(phi)
-    alpha = cam.pressure_angle(phi)
+    now = cam.state(phi)
+    motion, profile, alpha = now.motion, now.profile, now.pressure_angle
+    pitch = now.base if cam.is_roller else cam.pitch(phi)
     findings: list[Finding] = []
 
-    alpha_max = maximum(
-        lambda p, side: np.abs(cam.pressure_angle(p, side=side)), phi, joints, values=np.abs(alpha)
-    )
-    radius = np.hypot(profile.point[:, 0], profile.point[:, 1])
-    radius_min, radius_max = extremes(
-        lambda p, side: np.hypot(*cam.profile(p, side=side).point.T), phi, joints, values=radius
-    )
-    convex_min = minimum(
-        lambda p, side: _convex(cam.profile(p, side=side).rho), phi, joints, values=_convex(profile.rho)
-    )
-    concave_min = minimum(
-        lambda p, side: _concave(cam.profile(p, side=side).rho), phi, joints, values=_concave(profile.rho)
+    roller = cam.is_roller
+    kinds: tuple[Kind, ...] = ("max", "min", "max", "min", "min", "min", "min", "max")
+
+    def rows(p: FloatArray, side: Side) -> FloatArray:
+        """|α|, profile radius (min, max), convex ρ, concave ρ, undercut quantity, contact x (min, max)."""
+        st = cam.state(p, side=side)
+        radius = np.hypot(st.profile.point[:, 0], st.profile.point[:, 1])
+        rho = st.profile.rho
+        undercut = _convex(st.base.rho) if roller else rho
+        x = st.contact_x
+        return np.vstack(
+            (np.abs(st.pressure_angle), radius, radius, _convex(rho), _concave(rho), undercut, x, x)
+        )
+
+    values = rows(phi, "right")
+    alpha_max, radius_min, radius_max, convex_min, concave_min, worst, reach_min, reach_max = extremes_rows(
+        rows, phi, joints, kinds, values=values
     )
 
     if alpha_max.value > max_pressure_angle:
@@ -221,10 +225,7 @@ def analyse_geometry(
         )
 
     face_min = None
-    if not cam.is_roller:
-        reach_min, reach_max = extremes(
-            lambda p, side: cam.contact_offset(p, side=side), phi, joints, values=cam.contact_offset(phi)
-        )
+    if not roller:
         far = reach_max if abs(reach_max.value) >= abs(reach_min.value) else reach_min
         reach = abs(far.value)
         face_min = 2.0 * (reach + face_margin)
@@ -247,11 +248,9 @@ def analyse_geometry(
             )
 
     quantity, limit = _undercut_quantity(cam)
-    values = quantity(phi, "right")
-    worst = minimum(quantity, phi, joints, values=values)
     undercut = None
-    bad = values < limit if cam.is_roller else values <= limit
-    if worst.value < limit or (not cam.is_roller and worst.value <= limit):
+    bad = values[5] < limit if roller else values[5] <= limit
+    if worst.value < limit or (not roller and worst.value <= limit):
         ranges = flagged_ranges(phi, bad)
         if not ranges:
             ranges = [_bad_range(quantity, limit, worst, h)]

@@ -26,7 +26,7 @@ from camcad.geometry.envelope import (
 from camcad.geometry.followers import Follower, TranslatingFlat, TranslatingRoller
 from camcad.motion.program import Motion, MotionProgram, Side
 
-__all__ = ["Cam", "follower_from_spec"]
+__all__ = ["Cam", "CamState", "follower_from_spec"]
 
 
 def follower_from_spec(spec: FollowerSpec, base_radius: float) -> Follower:
@@ -36,6 +36,22 @@ def follower_from_spec(spec: FollowerSpec, base_radius: float) -> Follower:
             base_radius=base_radius, roller_radius=spec.roller_radius, eccentricity=spec.offset
         )
     return TranslatingFlat(base_radius=base_radius, eccentricity=spec.offset)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CamState:
+    """The cam at some angles, from one evaluation (see :meth:`Cam.state`); arrays (n,) or (n, 2).
+
+    ``base`` is the curve offsets are taken from: the pitch curve of a roller,
+    the profile of a face. ``contact_x`` is the contact's distance from the
+    follower axis along the machine's +x [mm] (see :meth:`Cam.contact_offset`).
+    """
+
+    motion: Motion
+    base: CurveSample
+    profile: CurveSample
+    pressure_angle: FloatArray
+    contact_x: FloatArray
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -166,6 +182,33 @@ class Cam:
         profile = offset_curve(base, drho, profile_at)
         driven = base.point if self.is_roller else profile.point
         return profile, to_cam(profile.phi, driven, -self.sigma)
+
+    def state(self, phi: ArrayLike, *, side: Side = "right") -> CamState:
+        """Everything at cam angles φ [rad] from one evaluation: motion, base curve, profile, α, contact.
+
+        The analyses refine many quantities at once on the same angles; this
+        computes the contact element and its envelope once for all of them.
+        """
+        m, element = self._element(phi, side)
+        if isinstance(element, PointElement):
+            base, drho = point_envelope(m.phi, element, self.sigma)
+            profile = offset_curve(base, drho, -self.roller_radius)
+            driven = base.point
+        else:
+            base, drho = line_envelope(m.phi, element, self.sigma)
+            profile = base
+            driven = profile.point
+        alpha = pressure_angle(
+            m.phi, profile.normal, to_cam(m.phi, driven, -self.sigma), self.kinematics.guide, self.sigma
+        )
+        contact = to_cam(m.phi, profile.point, -self.sigma)
+        return CamState(
+            motion=m,
+            base=base,
+            profile=profile,
+            pressure_angle=alpha,
+            contact_x=contact[:, 0] - self.offset_e,
+        )
 
     def pressure_angle(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
         """Signed pressure angle α [rad] at cam angles φ [rad].

@@ -9,7 +9,7 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.errors import DesignError
-from camcad.extremes import Extreme, Side, maximum, minimum
+from camcad.extremes import Extreme, Side, extremes_rows
 from camcad.geometry.cam import Cam
 
 __all__ = ["SizingResult", "feasible_margins", "min_base_radius"]
@@ -48,18 +48,18 @@ def feasible_margins(
     ``phi`` [rad] and taken at both sides of every joint.
     """
     joints = [bp.phi for bp in cam.program.breakpoints]
+    roller = cam.is_roller
 
-    def alpha(p: FloatArray, side: Side) -> FloatArray:
-        return np.abs(cam.pressure_angle(p, side=side))
+    def rows(p: FloatArray, side: Side) -> FloatArray:
+        """|α| and the convex profile radius (for a roller: convex pitch ρ − r_f)."""
+        st = cam.state(p, side=side)
+        if roller:
+            rho = np.where(st.base.rho > 0, st.base.rho - cam.roller_radius, np.inf)
+        else:
+            rho = st.profile.rho
+        return np.vstack((np.abs(st.pressure_angle), rho))
 
-    def rho(p: FloatArray, side: Side) -> FloatArray:
-        if cam.is_roller:
-            rho_pitch = cam.pitch(p, side=side).rho
-            return np.where(rho_pitch > 0, rho_pitch - cam.roller_radius, np.inf)
-        return cam.profile(p, side=side).rho
-
-    worst_alpha = maximum(alpha, phi, joints)
-    worst_rho = minimum(rho, phi, joints)
+    worst_alpha, worst_rho = extremes_rows(rows, phi, joints, ("max", "min"))
     margin_rho = worst_rho.value - min_curvature_radius
     return max_pressure_angle - worst_alpha.value, margin_rho, worst_alpha, worst_rho
 
