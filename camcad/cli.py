@@ -165,13 +165,18 @@ def _cmd_size(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _terminal_text(text: str) -> str:
+    """One line of printable text: control characters (a newline in a cam name) become spaces."""
+    return " ".join("".join(c if c.isprintable() else " " for c in text).split())
+
+
 def _cmd_compare(args: argparse.Namespace) -> int:
     from camcad.design import load_design
     from camcad.pipeline import analyse
     from camcad.report import compare_table, write_compare
 
     analyses = [analyse(load_design(p), strict=False, toolpath=False) for p in args.designs]
-    table = compare_table(analyses)
+    table = [[_terminal_text(cell) for cell in row] for row in compare_table(analyses)]
     widths = [max(len(row[i]) for row in table) for i in range(len(table[0]))]
     for row in table:
         print("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())

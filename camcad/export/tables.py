@@ -111,8 +111,9 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation) -> FloatArr
     if np.any(np.diff(angle) <= 0.0):
         bad = float(grid[int(np.argmax(np.diff(angle) <= 0.0))])
         raise NotStarShapedError(
-            f"the profile is not star-shaped about the cam axis near cam angle "
-            f"{math.degrees(bad):.2f}°: a ray meets it twice, so lift.csv has no polar radius"
+            f"cam.base_radius: the profile is not star-shaped about the cam axis near cam angle "
+            f"{math.degrees(bad):.2f}°: a ray meets it twice, so lift.csv has no polar radius; "
+            "use a larger cam.base_radius or a smaller follower.offset"
         )
     start = angle[0]
     target = start + np.mod(theta - start, 2.0 * math.pi)  # in [θ_C(0), θ_C(0) + 2π)

@@ -1,0 +1,19 @@
+"""A cam name with control characters cannot break the compare table into extra lines (issue 12)."""
+
+from __future__ import annotations
+
+from camcad.cli import main
+from tests.cli.test_cli import HARMONIC, edit
+
+
+def test_compare_prints_one_line_per_quantity_whatever_the_names(tmp_path, capsys):
+    plain, hostile = tmp_path / "a.toml", tmp_path / "b.toml"
+    plain.write_text(HARMONIC)
+    hostile.write_text(edit(HARMONIC, r"^name = .*$", 'name = "evil\\\\nM30\\\\n\\\\u001b[2Jname"'))
+    assert main(["compare", str(plain), str(plain)]) == 0
+    reference = capsys.readouterr().out.splitlines()
+    assert main(["compare", str(plain), str(hostile)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == len(reference)
+    assert all("\x1b" not in line for line in lines)
+    assert "evil M30" in lines[0]
