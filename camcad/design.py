@@ -32,8 +32,13 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from camcad.dynamics.spec import DynamicsModel, DynamicsSetup, DynamicsSpec
 from camcad.errors import DesignError
-from camcad.motion.laws import LAWS, Law, make_law
+from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
+from camcad.fit.spec import FitSpec
+from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
+from camcad.motion.laws import LAWS, make_law
+from camcad.motion.segments import SegmentKind, SegmentSpec
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -65,35 +70,6 @@ DEG = math.pi / 180.0
 FULL_TURN_DEG = 360.0
 ANGLE_SUM_TOL_DEG = 1e-9
 LIFT_CLOSE_TOL_MM = 1e-9
-
-
-class Rotation(enum.Enum):
-    """Direction the cam turns, seen from the viewer."""
-
-    CCW = "ccw"
-    CW = "cw"
-
-
-class FollowerKind(enum.Enum):
-    """Kinds of follower."""
-
-    TRANSLATING_ROLLER = "translating-roller"
-    TRANSLATING_FLAT = "translating-flat"
-
-
-class SegmentKind(enum.Enum):
-    """Kinds of motion segment."""
-
-    RISE = "rise"
-    RETURN = "return"
-    DWELL = "dwell"
-
-
-class DynamicsModel(enum.Enum):
-    """Dynamic models: energy method (Quintero & Vanegas 2016) or guided tappet (Hren et al.)."""
-
-    ENERGY = "energy"
-    GUIDED_TAPPET = "guided-tappet"
 
 
 class Dialect(enum.Enum):
@@ -131,95 +107,6 @@ class CamSpec:
     def omega(self) -> float:
         """Cam angular speed ω [rad/s]."""
         return self.speed_rpm * 2.0 * math.pi / 60.0
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class FollowerSpec:
-    """The follower. Lengths mm."""
-
-    kind: FollowerKind = FollowerKind.TRANSLATING_ROLLER
-    roller_radius: float = 0.0
-    offset: float = 0.0  # e > 0 puts the follower axis at x = +e, whatever the rotation
-    face_width: float | None = None
-    face_margin: float = 1.0  # mm beyond the contact's travel at each edge of a flat face
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class SegmentSpec:
-    """One rise, return or dwell. ``span`` rad, ``lift`` mm (positive for rise and return)."""
-
-    kind: SegmentKind
-    span: float
-    lift: float = 0.0
-    law: Law | None = None
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class DynamicsSpec:
-    """Masses, springs, friction and materials. SI-mm units: kg, N, N/mm, N·mm, MPa, mm."""
-
-    model: DynamicsModel = DynamicsModel.ENERGY
-    follower_mass: float = 0.0
-    spring_rate: float = 0.0  # N/mm
-    spring_preload: float = 0.0  # N at s = 0
-    friction_torque: float = 0.0  # N·mm
-    gravity: bool = True
-    min_contact_force: float = 0.0  # N
-    # guided tappet (Hren et al., section 2)
-    f1: float = 0.0
-    f2: float = 0.0
-    f3: float = 0.0
-    a_m: float = 0.0  # mm
-    b_m: float = 0.0  # mm
-    wire_diameter: float | None = None  # mm, coil spring by eq. 13
-    coil_diameter: float | None = None  # mm
-    active_coils: float | None = None
-    shear_modulus: float | None = None  # MPa
-    preload_deflection: float | None = None  # mm (y1)
-    # contact stress
-    contact_width: float | None = None  # mm; None: the cam thickness
-    cam_modulus: float = 206000.0  # MPa
-    cam_poisson: float = 0.3
-    follower_modulus: float = 206000.0  # MPa
-    follower_poisson: float = 0.3
-    allowable_stress: float | None = None  # MPa
-
-    @property
-    def uses_coil_spring(self) -> bool:
-        """Whether the spring is given by its coil geometry (Hren et al., eq. 13)."""
-        return self.wire_diameter is not None
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class FitSpec:
-    """NURBS fit settings. ``tolerance`` mm."""
-
-    tolerance: float = 1e-3
-    max_control_points: int | None = None  # None: automatic (as many as the fit's samples allow)
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class DxfSpec:
-    """DXF settings. ``chord_tolerance`` mm, for the polyline DXF."""
-
-    pitch_curve: bool = True
-    chord_tolerance: float = 0.005
-    annotate: bool = True
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class MeshSpec:
-    """Solid settings. ``chord_tolerance`` mm."""
-
-    formats: tuple[str, ...] = ("stl",)
-    chord_tolerance: float = 0.005
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class TablesSpec:
-    """Resolution of ``points.csv`` and ``lift.csv``; ``step`` rad."""
-
-    step: float = 1.0 * DEG
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -267,6 +154,20 @@ class Design:
     tables: TablesSpec = field(default_factory=TablesSpec)
     gcode: GcodeSpec = field(default_factory=GcodeSpec)
     source: str = ""
+
+    def dynamics_setup(self) -> DynamicsSetup:
+        """The dynamics stage's options: ``[dynamics]`` with the speed and contact geometry it uses."""
+        dyn, cam, fol = self.dynamics, self.cam, self.follower
+        roller = fol.kind is FollowerKind.TRANSLATING_ROLLER
+        return DynamicsSetup(
+            spec=dyn,
+            omega=cam.omega,
+            base_radius=cam.base_radius,
+            contact_length=dyn.contact_width if dyn.contact_width is not None else cam.thickness,
+            roller_radius=fol.roller_radius if roller else 0.0,
+            # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
+            tappet_offset=fol.offset if cam.rotation is Rotation.CCW else -fol.offset,
+        )
 
     def with_base_radius(self, base_radius: float) -> Design:
         """The same design with another base radius [mm]."""

@@ -152,7 +152,7 @@ def analyse(
             motion,
             pressure_angle=geometry.pressure_angle,
             profile_rho=geometry.profile.rho,
-            design=design,
+            setup=design.dynamics_setup(),
             cam=cam,
         ),
     )
@@ -356,6 +356,6 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
         motion_csv,
         profile_csv,
         dynamics_csv,
-        write_points_csv(folder / "points.csv", cam, design),
-        write_lift_csv(folder / "lift.csv", cam, design),
+        write_points_csv(folder / "points.csv", cam, design.tables),
+        write_lift_csv(folder / "lift.csv", cam, design.tables),
     ]

@@ -15,18 +15,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
-from camcad.design import DynamicsModel, DynamicsSpec, FollowerKind, Rotation
 from camcad.dynamics.contact import contact_curvature, effective_modulus, hertz_stress
 from camcad.dynamics.energy import FollowerLoad, contact_force, input_torque
 from camcad.dynamics.jump import covering_arc, loss_runs, speed_window
 from camcad.dynamics.results import DynamicsResult
+from camcad.dynamics.spec import DynamicsModel, DynamicsSetup, DynamicsSpec
 from camcad.dynamics.spring import spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, tappet_forces
 from camcad.extremes import Extreme, Kind, Side, extremes_rows
 from camcad.findings import Finding, Severity
 
 if TYPE_CHECKING:
-    from camcad.design import Design
     from camcad.geometry.cam import Cam
     from camcad.motion.program import Motion
 
@@ -98,33 +97,30 @@ class _Pointwise:
     far: FloatArray | None = None
 
 
-def _model(design: Design) -> Callable[[Motion, FloatArray, FloatArray], _Pointwise]:
+def _model(setup: DynamicsSetup) -> Callable[[Motion, FloatArray, FloatArray], _Pointwise]:
     """The design's dynamic model as a pointwise function of (motion, pressure angle α, profile ρ)."""
-    dyn = design.dynamics
+    dyn = setup.spec
     spring = spring_from_spec(dyn)
     load = FollowerLoad(mass=dyn.follower_mass, spring=spring, gravity=dyn.gravity)
-    omega = design.cam.omega
-    roller = design.follower.roller_radius
-    if design.follower.kind is not FollowerKind.TRANSLATING_ROLLER:
-        roller = 0.0
+    omega = setup.omega
+    roller = setup.roller_radius
     modulus = effective_modulus(
         modulus_1=dyn.cam_modulus,
         poisson_1=dyn.cam_poisson,
         modulus_2=dyn.follower_modulus,
         poisson_2=dyn.follower_poisson,
     )
-    length = dyn.contact_width if dyn.contact_width is not None else design.cam.thickness
+    length = setup.contact_length
     tappet = None
     if dyn.model is DynamicsModel.GUIDED_TAPPET:
         tappet = GuidedTappet(
-            base_radius=design.cam.base_radius,
+            base_radius=setup.base_radius,
             a_m=dyn.a_m,
             b_m=dyn.b_m,
             f1=dyn.f1,
             f2=dyn.f2,
             f3=dyn.f3,
-            # a cw cam is the mirror image of a ccw cam with the follower at −e
-            offset=design.follower.offset * (1.0 if design.cam.rotation is Rotation.CCW else -1.0),
+            offset=setup.tappet_offset,
         )
 
     def evaluate(motion: Motion, alpha: FloatArray, rho: FloatArray) -> _Pointwise:
@@ -162,7 +158,7 @@ def analyse_dynamics(
     *,
     pressure_angle: ArrayLike,
     profile_rho: ArrayLike,
-    design: Design,
+    setup: DynamicsSetup,
     cam: Cam | None = None,
 ) -> DynamicsResult:
     """Analyse contact force, drive torque, jump limits and Hertz stress over the cam turn.
@@ -177,9 +173,9 @@ def analyse_dynamics(
     profile_rho
         (n,) signed radius of curvature of the cam profile at the contact
         [mm]: positive convex, negative concave.
-    design
-        Uses ``cam.omega`` [rad/s], ``cam.base_radius`` and ``cam.thickness``
-        [mm], ``follower`` (kind, roller radius, offset) and ``dynamics``.
+    setup
+        The ``[dynamics]`` table with the cam speed and contact geometry
+        (``Design.dynamics_setup()`` builds it from a design).
     cam
         The exact cam. With it every reported extreme (forces, torque,
         stress, the jump verdict, the preload and speed limits) is the true
@@ -209,9 +205,9 @@ def analyse_dynamics(
     n = np.asarray(motion.phi).size
     alpha = _array("pressure_angle", pressure_angle, n)
     rho = _array("profile_rho", profile_rho, n)
-    dyn = design.dynamics
-    omega = design.cam.omega
-    model = _model(design)
+    dyn = setup.spec
+    omega = setup.omega
+    model = _model(setup)
     sampled = model(motion, alpha, rho)
     phi = np.array(motion.phi, dtype=float)
     margin = dyn.min_contact_force

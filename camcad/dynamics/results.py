@@ -14,8 +14,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from camcad._typing import FloatArray
-from camcad.design import DynamicsModel
 from camcad.dynamics.jump import covering_arc
+from camcad.dynamics.spec import DynamicsModel
 from camcad.errors import JumpError
 from camcad.extremes import SIDE_WORDS, Extreme
 from camcad.findings import Finding

@@ -17,7 +17,7 @@ import numpy as np
 from camcad._typing import ArrayLike, FloatArray, readonly
 
 if TYPE_CHECKING:
-    from camcad.design import DynamicsSpec
+    from camcad.dynamics.spec import DynamicsSpec
 
 __all__ = ["Spring", "coil_spring_rate", "spring_from_spec"]
 

@@ -36,9 +36,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from camcad._typing import FloatArray, readonly
-from camcad.design import Design, Rotation
 from camcad.errors import NotStarShapedError
 from camcad.export.records import write_csv
+from camcad.export.spec import TablesSpec
+from camcad.geometry.spec import Rotation
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -133,7 +134,7 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation) -> FloatArr
     return out
 
 
-def write_points_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> Path:
+def write_points_csv(path: str | os.PathLike[str], cam: Cam, options: TablesSpec) -> Path:
     """Write ``points.csv``: profile points per cam angle (module docstring).
 
     Parameters
@@ -142,15 +143,15 @@ def write_points_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> 
         Target file.
     cam
         The exact cam.
-    design
-        ``[tables].step`` [rad] sets the grid.
+    options
+        ``[tables]``: ``step`` [rad] sets the grid.
 
     Returns
     -------
     Path
         The written file.
     """
-    phi = table_angles(design.tables.step)
+    phi = table_angles(options.step)
     prof = cam.profile(phi)
     columns = [
         np.degrees(phi),
@@ -164,7 +165,7 @@ def write_points_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> 
     return write_csv(path, dict(zip(POINTS_HEADER.split(","), columns, strict=True)), formats=formats)
 
 
-def write_lift_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> Path:
+def write_lift_csv(path: str | os.PathLike[str], cam: Cam, options: TablesSpec) -> Path:
     """Write ``lift.csv``: lift per cam angle and polar radius per ray angle (module docstring).
 
     Parameters
@@ -173,8 +174,8 @@ def write_lift_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> Pa
         Target file.
     cam
         The exact cam.
-    design
-        ``[tables].step`` [rad] sets the grid; ``[cam].rotation`` the sense of θ.
+    options
+        ``[tables]``: ``step`` [rad] sets the grid; the cam's rotation the sense of θ.
 
     Returns
     -------
@@ -186,8 +187,8 @@ def write_lift_csv(path: str | os.PathLike[str], cam: Cam, design: Design) -> Pa
     NotStarShapedError
         When the profile is not star-shaped about the cam axis.
     """
-    angle = table_angles(design.tables.step)
+    angle = table_angles(options.step)
     lift = cam.motion(angle).s
-    radius = polar_radius(cam, angle, rotation=design.cam.rotation)
+    radius = polar_radius(cam, angle, rotation=cam.rotation)
     columns = dict(zip(LIFT_HEADER.split(","), [np.degrees(angle), lift, radius], strict=True))
     return write_csv(path, columns, formats=["{:.6f}"] * 3)

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from camcad._typing import ArrayLike, FloatArray, readonly
-from camcad.design import Design, FollowerKind, FollowerSpec, Rotation
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import (
     LineElement,
@@ -24,7 +24,11 @@ from camcad.geometry.envelope import (
     to_cam,
 )
 from camcad.geometry.followers import Follower, TranslatingFlat, TranslatingRoller
+from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
 from camcad.motion.program import Motion, MotionProgram, Side
+
+if TYPE_CHECKING:  # the design schema sits above the stages; only its shape is used here
+    from camcad.design import Design
 
 __all__ = ["Cam", "CamState", "follower_from_spec"]
 

@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
-from camcad.design import SegmentKind, SegmentSpec
+from camcad.motion.segments import SegmentKind, SegmentSpec
 
 __all__ = [
     "TWO_PI",

@@ -35,7 +35,7 @@ def analyse(design, step=None) -> DynamicsResult:
         cam.motion(phi),
         pressure_angle=cam.pressure_angle(phi),
         profile_rho=cam.profile(phi).rho,
-        design=design,
+        setup=design.dynamics_setup(),
     )
 
 
@@ -96,7 +96,7 @@ def test_convex_roller_stress_by_hand():
         cam.motion(phi),
         pressure_angle=cam.pressure_angle(phi),
         profile_rho=cam.profile(phi).rho,
-        design=design,
+        setup=design.dynamics_setup(),
     )
     assert result.contact_force[0] == pytest.approx(4.63, rel=1e-12)
     expected = math.sqrt(4.63 * (206000 / 1.82) * (1 / 70 + 1 / 20) / (math.pi * 10.0))
@@ -109,4 +109,6 @@ def test_array_lengths_must_match():
     cam = Cam.from_design(design)
     phi = np.radians([10.0, 20.0])
     with pytest.raises(ValueError, match="pressure_angle has 1 samples"):
-        analyse_dynamics(cam.motion(phi), pressure_angle=[0.0], profile_rho=[1.0, 1.0], design=design)
+        analyse_dynamics(
+            cam.motion(phi), pressure_angle=[0.0], profile_rho=[1.0, 1.0], setup=design.dynamics_setup()
+        )

@@ -61,7 +61,7 @@ def analyse(design: Design):
         cam.motion(phi),
         pressure_angle=cam.pressure_angle(phi),
         profile_rho=cam.profile(phi).rho,
-        design=design,
+        setup=design.dynamics_setup(),
     )
     return cam, result
 
@@ -201,7 +201,7 @@ def test_paper_case_statics_on_the_dwell():
         cam.motion(phi),
         pressure_angle=cam.pressure_angle(phi),
         profile_rho=cam.profile(phi).rho,
-        design=design,
+        setup=design.dynamics_setup(),
     )
     assert_allclose(result.contact_force, 4.63, rtol=1e-12)
     assert_allclose(result.torque, 100.0, rtol=1e-12)

@@ -40,7 +40,7 @@ def analyse(design: Design):
         cam.motion(phi),
         pressure_angle=cam.pressure_angle(phi),
         profile_rho=cam.profile(phi).rho,
-        design=design,
+        setup=design.dynamics_setup(),
     )
 
 

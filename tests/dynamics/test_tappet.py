@@ -169,7 +169,10 @@ def test_table1_torque_at_phi0_by_hand():
     cam = Cam.from_design(design)
     phi = np.array([0.0])
     result = analyse_dynamics(
-        cam.motion(phi), pressure_angle=np.zeros(1), profile_rho=cam.profile(phi).rho, design=design
+        cam.motion(phi),
+        pressure_angle=np.zeros(1),
+        profile_rho=cam.profile(phi).rho,
+        setup=design.dynamics_setup(),
     )
     force = 31.6 * 10.0 + 0.6 * 9.80665
     n1 = force * 500.0 / 492.0
@@ -190,7 +193,10 @@ def test_table1_stroke_maximum_against_exact_dudley_polynomial():
     cam = Cam.from_design(design)
     phi = cam.sample_phi()
     result = analyse_dynamics(
-        cam.motion(phi), pressure_angle=np.zeros(phi.size), profile_rho=cam.profile(phi).rho, design=design
+        cam.motion(phi),
+        pressure_angle=np.zeros(phi.size),
+        profile_rho=cam.profile(phi).rho,
+        setup=design.dynamics_setup(),
     )
     stroke = phi <= math.pi / 2
     k = int(np.argmax(result.torque[stroke]))

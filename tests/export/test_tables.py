@@ -76,7 +76,7 @@ def test_table_grid_closes_the_turn():
 
 def test_points_csv_is_the_exact_profile(case, tmp_path):
     design, cam = case
-    data = read_csv(write_points_csv(tmp_path / "points.csv", cam, design), POINTS_HEADER)
+    data = read_csv(write_points_csv(tmp_path / "points.csv", cam, design.tables), POINTS_HEADER)
     phi = table_angles(design.tables.step)
     assert data.shape == (len(phi), 6)
     assert_allclose(data[:, 0], np.degrees(phi), rtol=0, atol=5e-7)
@@ -90,7 +90,7 @@ def test_points_csv_is_the_exact_profile(case, tmp_path):
 
 def test_lift_csv_lift_and_polar_radius(case, tmp_path):
     design, cam = case
-    data = read_csv(write_lift_csv(tmp_path / "lift.csv", cam, design), LIFT_HEADER)
+    data = read_csv(write_lift_csv(tmp_path / "lift.csv", cam, design.tables), LIFT_HEADER)
     angle = table_angles(design.tables.step)
     assert_allclose(data[:, 0], np.degrees(angle), rtol=0, atol=5e-7)
     assert_allclose(data[:, 1], cam.motion(angle).s, rtol=0, atol=5e-7)
@@ -120,7 +120,7 @@ def test_polar_radius_is_not_the_contact_radius(case):
 def test_steps_from_the_design(tmp_path):
     design = make_design(extra={"tables": {"step_deg": 2.5}})
     cam = Cam.from_design(design)
-    data = read_csv(write_lift_csv(tmp_path / "lift.csv", cam, design), LIFT_HEADER)
+    data = read_csv(write_lift_csv(tmp_path / "lift.csv", cam, design.tables), LIFT_HEADER)
     assert len(data) == 144 and data[1, 0] == 2.5
 
 
@@ -137,6 +137,8 @@ class _Lift:
 @dataclass(frozen=True)
 class FoldedCam:
     """A stand-in whose polar angle runs backwards near φ = π/2: not star-shaped."""
+
+    rotation = Rotation.CCW
 
     def profile(self, phi):
         phi = np.asarray(phi, dtype=float)
@@ -160,5 +162,5 @@ def test_failed_table_leaves_no_file(tmp_path):
     design = make_design()
     cam = FoldedCam()
     with pytest.raises(ExportError):
-        write_lift_csv(tmp_path / "lift.csv", cam, design)  # type: ignore[arg-type]
+        write_lift_csv(tmp_path / "lift.csv", cam, design.tables)  # type: ignore[arg-type]
     assert list(tmp_path.iterdir()) == []
