@@ -36,6 +36,7 @@ from camcad.dynamics.spec import DynamicsModel, DynamicsSetup, DynamicsSpec
 from camcad.errors import DesignError
 from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fit.spec import FitSpec
+from camcad.geometry.plate import BoreOutline, Plate
 from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
 from camcad.motion.laws import LAWS, make_law
 from camcad.motion.segments import SegmentKind, SegmentSpec
@@ -154,6 +155,15 @@ class Design:
     tables: TablesSpec = field(default_factory=TablesSpec)
     gcode: GcodeSpec = field(default_factory=GcodeSpec)
     source: str = ""
+
+    def plate(self) -> Plate:
+        """The plate the writers take: name, thickness, bore and keyway."""
+        cam = self.cam
+        return Plate(
+            name=cam.name,
+            thickness=cam.thickness,
+            bore=BoreOutline.from_cam_spec(cam.bore, cam.keyway_width, cam.keyway_depth),
+        )
 
     def dynamics_setup(self) -> DynamicsSetup:
         """The dynamics stage's options: ``[dynamics]`` with the speed and contact geometry it uses."""

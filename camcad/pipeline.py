@@ -270,6 +270,7 @@ def _write_outputs(
 ) -> list[Path]:
     """Write the selected output groups into ``folder``; return the paths written."""
     design, cam, timings = analysis.design, analysis.cam, analysis.timings
+    plate = design.plate()
     written: list[Path] = []
 
     def stage(name: str, fn: Callable[[], Any]) -> None:
@@ -284,8 +285,12 @@ def _write_outputs(
         stage(
             "dxf",
             lambda: [
-                write_profile_dxf(folder / "profile.dxf", cam=cam, fit=analysis.fit, design=design),
-                write_profile_poly_dxf(folder / "profile_poly.dxf", cam=cam, fit=analysis.fit, design=design),
+                write_profile_dxf(
+                    folder / "profile.dxf", cam=cam, fit=analysis.fit, plate=plate, options=design.dxf
+                ),
+                write_profile_poly_dxf(
+                    folder / "profile_poly.dxf", cam=cam, fit=analysis.fit, plate=plate, options=design.dxf
+                ),
             ],
         )
     if "stl" in groups:
@@ -293,7 +298,9 @@ def _write_outputs(
 
         stage(
             "mesh",
-            lambda: write_meshes(folder, build_solid(analysis.fit, design, cam=cam), design.mesh.formats),
+            lambda: write_meshes(
+                folder, build_solid(analysis.fit, plate, design.mesh, cam=cam), design.mesh.formats
+            ),
         )
     if "gcode" in groups:
         from camcad.export.gcode import render_gcode

@@ -36,7 +36,7 @@ import os
 import re
 import unicodedata
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 # First: this imports ezdxf without the user's config files and font cache.
 from camcad.export._ezdxf import ezdxf, save_reproducible
@@ -47,11 +47,15 @@ from ezdxf import zoom
 from ezdxf.document import Drawing
 from ezdxf.layouts import Modelspace
 
-from camcad.design import Design, FollowerKind, SegmentKind
 from camcad.errors import ExportError
-from camcad.export._contours import BoreOutline, flatten_bspline, flatten_curve
+from camcad.export._contours import flatten_bspline, flatten_curve
 from camcad.export.atomic import atomic_write
+from camcad.export.spec import DxfSpec
 from camcad.fit.curve import BSplineCurve
+from camcad.fit.result import ProfileFit
+from camcad.geometry.plate import BoreOutline, Plate
+from camcad.geometry.spec import FollowerKind
+from camcad.motion.segments import SegmentKind
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -80,19 +84,6 @@ LAYERS: dict[str, tuple[int, str]] = {
     "CENTER": (4, "CENTER"),
     "ANNOTATION": (2, "Continuous"),
 }
-
-
-class _Fit(Protocol):
-    """What the exporters need of :class:`camcad.fit.ProfileFit`."""
-
-    @property
-    def clamped(self) -> BSplineCurve: ...  # closed clamped cubic [mm]
-
-    @property
-    def max_error(self) -> float: ...  # mm
-
-    @property
-    def tolerance(self) -> float: ...  # mm
 
 
 def _new_document() -> tuple[Drawing, Modelspace]:
@@ -146,11 +137,6 @@ def _add_closed_polyline(msp: Modelspace, points: np.ndarray, layer: str) -> Non
     )
 
 
-def _bore(design: Design) -> BoreOutline | None:
-    cam = design.cam
-    return BoreOutline.from_cam_spec(cam.bore, cam.keyway_width, cam.keyway_depth)
-
-
 def _add_bore_exact(msp: Modelspace, bore: BoreOutline) -> None:
     if not bore.has_keyway:
         msp.add_circle((0.0, 0.0), bore.radius, dxfattribs={"layer": "BORE"})
@@ -187,14 +173,14 @@ def dxf_text(text: str) -> str:
     return plain
 
 
-def _annotation_lines(design: Design, fit: _Fit) -> list[str]:
+def _annotation_lines(cam: Cam, plate: Plate, fit: ProfileFit) -> list[str]:
     """Plain-ASCII lines of the annotation block."""
-    cam, follower = design.cam, design.follower
-    sizes = f"base radius {cam.base_radius:.3f} mm, thickness {cam.thickness:.3f} mm"
-    if cam.bore > 0.0:
-        sizes += f", bore dia {cam.bore:.3f} mm"
-        if cam.keyway_width > 0.0:
-            sizes += f", keyway {cam.keyway_width:.3f} x {cam.keyway_depth:.3f} mm"
+    follower, bore = cam.follower, plate.bore
+    sizes = f"base radius {cam.base_radius:.3f} mm, thickness {plate.thickness:.3f} mm"
+    if bore is not None:
+        sizes += f", bore dia {2.0 * bore.radius:.3f} mm"
+        if bore.has_keyway:
+            sizes += f", keyway {bore.keyway_width:.3f} x {bore.keyway_depth:.3f} mm"
     if follower.kind is FollowerKind.TRANSLATING_ROLLER:
         who = f"roller radius {follower.roller_radius:.3f} mm"
     else:
@@ -202,12 +188,12 @@ def _annotation_lines(design: Design, fit: _Fit) -> list[str]:
             f" width {follower.face_width:.3f} mm" if follower.face_width is not None else ""
         )
     lines = [
-        f"CAM {cam.name}",
+        f"CAM {plate.name}",
         sizes,
         f"follower {follower.kind.value}, {who}, offset {follower.offset:.3f} mm, "
         f"rotation {cam.rotation.value}",
     ]
-    for seg in design.motion:
+    for seg in cam.program.segments:
         span = f"{math.degrees(seg.span):.3f} deg"
         if seg.kind is SegmentKind.DWELL or seg.law is None:
             lines.append(f"{seg.kind.value} {span}")
@@ -235,7 +221,7 @@ def _audited(doc: Drawing, name: str) -> Drawing:
     return doc
 
 
-def profile_document(*, cam: Cam, fit: _Fit, design: Design) -> Drawing:
+def profile_document(*, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpec) -> Drawing:
     """Build the ``profile.dxf`` document (not saved); see the module docstring for layers.
 
     Parameters
@@ -244,8 +230,10 @@ def profile_document(*, cam: Cam, fit: _Fit, design: Design) -> Drawing:
         The exact cam; supplies the pitch curve.
     fit
         The certified profile fit; ``fit.clamped`` becomes the SPLINE.
-    design
-        Bore, keyway, annotation data and ``[dxf]`` settings.
+    plate
+        Name, thickness, bore and keyway.
+    options
+        ``[dxf]`` settings.
 
     Raises
     ------
@@ -254,26 +242,26 @@ def profile_document(*, cam: Cam, fit: _Fit, design: Design) -> Drawing:
     """
     doc, msp = _new_document()
     _add_profile_spline(msp, fit.clamped)
-    outline = flatten_bspline(fit.clamped, design.dxf.chord_tolerance)
+    outline = flatten_bspline(fit.clamped, options.chord_tolerance)
     reach = float(np.max(np.hypot(outline[:, 0], outline[:, 1])))
-    if design.dxf.pitch_curve and cam.is_roller:
+    if options.pitch_curve and cam.is_roller:
         breaks = [b.phi for b in cam.program.breakpoints]
-        pitch = flatten_curve(cam.pitch, design.dxf.chord_tolerance, breakpoints=breaks)
+        pitch = flatten_curve(cam.pitch, options.chord_tolerance, breakpoints=breaks)
         _add_closed_polyline(msp, pitch, "PITCH_CURVE")
         reach = max(reach, float(np.max(np.hypot(pitch[:, 0], pitch[:, 1]))))
-    bore = _bore(design)
+    bore = plate.bore
     if bore is not None:
         _add_bore_exact(msp, bore)
     reach += CENTER_OVERHANG
     _add_center_lines(msp, reach)
     bottom = -reach
-    if design.dxf.annotate:
-        bottom = _add_annotation(msp, _annotation_lines(design, fit), reach) - TEXT_HEIGHT
+    if options.annotate:
+        bottom = _add_annotation(msp, _annotation_lines(cam, plate, fit), reach) - TEXT_HEIGHT
     zoom.window(msp, (-reach - 5.0, bottom - 5.0), (reach + 5.0, reach + 5.0))
     return _audited(doc, "profile.dxf")
 
 
-def profile_poly_document(*, cam: Cam, fit: _Fit, design: Design) -> Drawing:
+def profile_poly_document(*, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpec) -> Drawing:
     """Build the ``profile_poly.dxf`` document: profile and bore as bulge-free LWPOLYLINEs.
 
     The profile is flattened from ``fit.clamped`` with a chord error bound of
@@ -283,9 +271,9 @@ def profile_poly_document(*, cam: Cam, fit: _Fit, design: Design) -> Drawing:
     """
     del cam
     doc, msp = _new_document()
-    tol = design.dxf.chord_tolerance
+    tol = options.chord_tolerance
     _add_closed_polyline(msp, flatten_bspline(fit.clamped, tol), "CAM_PROFILE")
-    bore = _bore(design)
+    bore = plate.bore
     if bore is not None:
         _add_closed_polyline(msp, bore.polygon(tol), "BORE")
     return _audited(doc, "profile_poly.dxf")
@@ -295,7 +283,9 @@ def _save(doc: Drawing, path: str | os.PathLike[str]) -> Path:
     return atomic_write(path, lambda tmp: save_reproducible(doc, tmp))
 
 
-def write_profile_dxf(path: str | os.PathLike[str], *, cam: Cam, fit: _Fit, design: Design) -> Path:
+def write_profile_dxf(
+    path: str | os.PathLike[str], *, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpec
+) -> Path:
     """Write ``profile.dxf`` atomically; see :func:`profile_document`.
 
     Returns
@@ -303,10 +293,12 @@ def write_profile_dxf(path: str | os.PathLike[str], *, cam: Cam, fit: _Fit, desi
     Path
         The written file.
     """
-    return _save(profile_document(cam=cam, fit=fit, design=design), path)
+    return _save(profile_document(cam=cam, fit=fit, plate=plate, options=options), path)
 
 
-def write_profile_poly_dxf(path: str | os.PathLike[str], *, cam: Cam, fit: _Fit, design: Design) -> Path:
+def write_profile_poly_dxf(
+    path: str | os.PathLike[str], *, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpec
+) -> Path:
     """Write ``profile_poly.dxf`` atomically; see :func:`profile_poly_document`.
 
     Returns
@@ -314,4 +306,4 @@ def write_profile_poly_dxf(path: str | os.PathLike[str], *, cam: Cam, fit: _Fit,
     Path
         The written file.
     """
-    return _save(profile_poly_document(cam=cam, fit=fit, design=design), path)
+    return _save(profile_poly_document(cam=cam, fit=fit, plate=plate, options=options), path)

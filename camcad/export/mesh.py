@@ -36,7 +36,7 @@ import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 import manifold3d
 import meshio
@@ -44,10 +44,8 @@ import numpy as np
 import trimesh
 
 from camcad._typing import FloatArray, readonly
-from camcad.design import Design
 from camcad.errors import ExportError
 from camcad.export._contours import (
-    BoreOutline,
     analytic_area,
     bspline_area,
     bspline_length,
@@ -56,7 +54,9 @@ from camcad.export._contours import (
     polygon_area,
 )
 from camcad.export.atomic import atomic_write, atomic_write_bytes
-from camcad.fit.curve import BSplineCurve
+from camcad.export.spec import MeshSpec
+from camcad.fit.result import ProfileFit
+from camcad.geometry.plate import BoreOutline, Plate
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -75,16 +75,6 @@ VOLUME_RTOL = 1e-6  # mesh volume vs polygon area × thickness
 # 80-byte binary STL header: says the unit, and must not begin with "solid" (ASCII STL)
 STL_HEADER = b"camcad cam plate, binary STL, units mm".ljust(80, b"\0")
 AREA_ROUNDOFF = 1e-9  # relative slack for round-off in the area comparisons
-
-
-class _Fit(Protocol):
-    """What the solid needs of :class:`camcad.fit.ProfileFit`."""
-
-    @property
-    def clamped(self) -> BSplineCurve: ...  # closed clamped cubic [mm]
-
-    @property
-    def max_error(self) -> float: ...  # mm
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -135,10 +125,10 @@ class SolidResult:
     fit_area_bound: float | None
 
 
-def _cross_section(fit: _Fit, design: Design, tol: float) -> tuple[list[FloatArray], BoreOutline | None]:
+def _cross_section(fit: ProfileFit, plate: Plate, tol: float) -> tuple[list[FloatArray], BoreOutline | None]:
     outline = oriented(np.asarray(flatten_bspline(fit.clamped, tol)), ccw=True)
     contours = [outline]
-    bore = BoreOutline.from_cam_spec(design.cam.bore, design.cam.keyway_width, design.cam.keyway_depth)
+    bore = plate.bore
     if bore is not None:
         contours.append(oriented(np.asarray(bore.polygon(tol)), ccw=False))
     for contour in contours:
@@ -147,7 +137,7 @@ def _cross_section(fit: _Fit, design: Design, tol: float) -> tuple[list[FloatArr
 
 
 def _check_areas(
-    fit: _Fit, cam: Cam | None, bore: BoreOutline | None, polygon: float, tol: float
+    fit: ProfileFit, cam: Cam | None, bore: BoreOutline | None, polygon: float, tol: float
 ) -> tuple[float, float, float | None, float | None]:
     """Compare polygon, spline and analytic areas; returns (spline, chord bound, profile, fit bound)."""
     hole_area = bore.area if bore is not None else 0.0
@@ -177,16 +167,17 @@ def _check_areas(
     return spline, chord_bound, profile, fit_bound
 
 
-def build_solid(fit: _Fit, design: Design, *, cam: Cam | None = None) -> SolidResult:
+def build_solid(fit: ProfileFit, plate: Plate, options: MeshSpec, *, cam: Cam | None = None) -> SolidResult:
     """Extrude the fitted profile, less bore and keyway, to a checked closed solid.
 
     Parameters
     ----------
     fit
         The profile fit; uses ``fit.clamped`` and ``fit.max_error`` [mm].
-    design
-        ``[cam].thickness``, ``bore`` (diameter), ``keyway_width``,
-        ``keyway_depth`` and ``[mesh].chord_tolerance`` [mm].
+    plate
+        Thickness, bore and keyway [mm].
+    options
+        ``[mesh]``: ``chord_tolerance`` [mm].
     cam
         The exact cam. When given, the spline's area is also checked against
         the analytic profile's (check 5 of the module docstring).
@@ -201,9 +192,9 @@ def build_solid(fit: _Fit, design: Design, *, cam: Cam | None = None) -> SolidRe
     ExportError
         When any check in the module docstring fails.
     """
-    tol = design.mesh.chord_tolerance
-    thickness = design.cam.thickness
-    contours, bore = _cross_section(fit, design, tol)
+    tol = options.chord_tolerance
+    thickness = plate.thickness
+    contours, bore = _cross_section(fit, plate, tol)
     holes = len(contours) - 1
     polygon = sum(polygon_area(c) for c in contours)
     section = manifold3d.CrossSection(contours, manifold3d.FillRule.Positive)

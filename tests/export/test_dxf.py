@@ -17,7 +17,7 @@ from scipy.spatial import cKDTree
 
 from camcad.design import Design
 from camcad.errors import ExportError
-from camcad.export._contours import BoreOutline, flatten_bspline, polygon_area
+from camcad.export._contours import flatten_bspline, polygon_area
 from camcad.export.dxf import (
     profile_document,
     write_profile_dxf,
@@ -25,7 +25,14 @@ from camcad.export.dxf import (
 )
 from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.geometry.cam import Cam
+from camcad.geometry.plate import BoreOutline
 from tests.conftest import distance_to_polygon, make_design
+
+
+def writer_options(design):
+    """The DXF writers' plate and options for a design."""
+    return {"plate": design.plate(), "options": design.dxf}
+
 
 KEYED = {"cam": {"bore": 12.0, "keyway_width": 4.0, "keyway_depth": 2.0}}
 DESIGNS = {
@@ -71,8 +78,8 @@ def written(case, tmp_path_factory) -> tuple[Path, Path]:
     design, cam, fit = case
     folder = tmp_path_factory.mktemp("dxf")
     return (
-        write_profile_dxf(folder / "profile.dxf", cam=cam, fit=fit, design=design),
-        write_profile_poly_dxf(folder / "profile_poly.dxf", cam=cam, fit=fit, design=design),
+        write_profile_dxf(folder / "profile.dxf", cam=cam, fit=fit, **writer_options(design)),
+        write_profile_poly_dxf(folder / "profile_poly.dxf", cam=cam, fit=fit, **writer_options(design)),
     )
 
 
@@ -188,7 +195,7 @@ def test_centre_lines_and_pitch_curve(case, written):
 def test_pitch_curve_and_annotation_can_be_switched_off(case):
     design, cam, fit = case
     design = replace(design, dxf=replace(design.dxf, pitch_curve=False, annotate=False))
-    msp = profile_document(cam=cam, fit=fit, design=design).modelspace()
+    msp = profile_document(cam=cam, fit=fit, **writer_options(design)).modelspace()
     assert len(msp.query('*[layer=="PITCH_CURVE"]')) == 0
     assert len(msp.query('*[layer=="ANNOTATION"]')) == 0
 
@@ -217,7 +224,7 @@ def test_periodic_curve_is_refused_and_nothing_is_written(case, tmp_path):
     design, cam, fit = case
     bad = replace(fit, clamped=fit.curve)  # the periodic encoding
     with pytest.raises(ExportError, match="periodic"):
-        write_profile_dxf(tmp_path / "profile.dxf", cam=cam, fit=bad, design=design)
+        write_profile_dxf(tmp_path / "profile.dxf", cam=cam, fit=bad, **writer_options(design))
     assert list(tmp_path.iterdir()) == []
 
 
@@ -227,11 +234,13 @@ def test_periodic_curve_is_refused_and_nothing_is_written(case, tmp_path):
 def test_the_same_drawing_gives_the_same_bytes(case, tmp_path, monkeypatch, order):
     """No clock, no random GUID, and the CLASSES section does not follow ezdxf's set order."""
     design, cam, fit = case
-    reference = write_profile_dxf(tmp_path / "one.dxf", cam=cam, fit=fit, design=design).read_bytes()
+    reference = write_profile_dxf(
+        tmp_path / "one.dxf", cam=cam, fit=fit, **writer_options(design)
+    ).read_bytes()
     in_use = EntityDB.dxf_types_in_use
     monkeypatch.setattr(EntityDB, "dxf_types_in_use", lambda self: order(in_use(self)))
     option = ezdxf.options.write_fixed_meta_data_for_testing
-    again = write_profile_dxf(tmp_path / "two.dxf", cam=cam, fit=fit, design=design).read_bytes()
+    again = write_profile_dxf(tmp_path / "two.dxf", cam=cam, fit=fit, **writer_options(design)).read_bytes()
     assert again == reference
     assert ezdxf.options.write_fixed_meta_data_for_testing == option  # the user's setting is restored
     lines = (tmp_path / "two.dxf").read_text().splitlines()  # raw: ezdxf replaces nil GUIDs when reading

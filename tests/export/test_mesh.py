@@ -19,11 +19,9 @@ from scipy.interpolate import make_interp_spline
 from camcad.design import Design
 from camcad.errors import ExportError
 from camcad.export._contours import (
-    BoreOutline,
     analytic_area,
     bspline_area,
     bspline_length,
-    circle_segments,
     flatten_bspline,
     polygon_area,
 )
@@ -33,6 +31,7 @@ from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.fit.bspline import clamped_from_periodic
 from camcad.fit.curve import BSplineCurve
 from camcad.geometry.cam import Cam
+from camcad.geometry.plate import BoreOutline, circle_segments
 from tests.conftest import distance_to_polygon, make_design
 
 KEYED = {"cam": {"bore": 12.0, "keyway_width": 4.0, "keyway_depth": 2.0}}
@@ -50,7 +49,7 @@ def cam_and_fit(design: Design) -> tuple[Cam, ProfileFit]:
 def keyed() -> tuple[Design, Cam, ProfileFit, SolidResult]:
     design = make_design(extra=KEYED)
     cam, fit = cam_and_fit(design)
-    return design, cam, fit, build_solid(fit, design, cam=cam)
+    return design, cam, fit, build_solid(fit, design.plate(), design.mesh, cam=cam)
 
 
 # -- contour maths -------------------------------------------------------------
@@ -176,7 +175,7 @@ def test_keyed_solid_passes_every_check(keyed):
 def test_solid_genus_counts_holes(kwargs):
     design = make_design(**kwargs)
     cam, fit = cam_and_fit(design)
-    solid = build_solid(fit, design, cam=cam)
+    solid = build_solid(fit, design.plate(), design.mesh, cam=cam)
     holes = 1 if design.cam.bore > 0 else 0
     assert solid.genus == holes == solid.holes
     assert solid.mesh.euler_number == 2 - 2 * holes
@@ -185,7 +184,7 @@ def test_solid_genus_counts_holes(kwargs):
 
 def test_without_cam_the_analytic_check_is_skipped(keyed):
     design, _, fit, solid = keyed
-    plain = build_solid(fit, design)
+    plain = build_solid(fit, design.plate(), design.mesh)
     assert plain.profile_area is None and plain.fit_area_bound is None
     assert plain.volume == solid.volume
 
@@ -200,7 +199,7 @@ def test_self_intersecting_profile_is_refused(keyed):
     eight = clamped_from_periodic(BSplineCurve(degree=3, knots=spl.t, control_points=spl.c, periodic=True))
     no_bore = replace(design, cam=replace(design.cam, bore=0.0, keyway_width=0.0, keyway_depth=0.0))
     with pytest.raises(ExportError, match="solid check failed"):
-        build_solid(replace(fit, clamped=eight), no_bore)
+        build_solid(replace(fit, clamped=eight), no_bore.plate(), no_bore.mesh)
 
 
 def test_a_fit_error_larger_than_claimed_is_caught(keyed):
@@ -210,7 +209,7 @@ def test_a_fit_error_larger_than_claimed_is_caught(keyed):
     scale = 1.0 - 0.05 / 60.0
     shrunk = BSplineCurve(degree=3, knots=c.knots, control_points=c.control_points * scale)
     with pytest.raises(ExportError, match="exact profile area"):
-        build_solid(replace(fit, clamped=shrunk, max_error=1e-6), design, cam=cam)
+        build_solid(replace(fit, clamped=shrunk, max_error=1e-6), design.plate(), design.mesh, cam=cam)
 
 
 # -- writers ---------------------------------------------------------------------------

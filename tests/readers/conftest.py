@@ -73,7 +73,7 @@ def built(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFacto
     cam = Cam.from_design(design)
     fit = _fit(design, cam)
     folder = tmp_path_factory.mktemp(request.param)
-    solid = build_solid(fit, design, cam=cam)
+    solid = build_solid(fit, design.plate(), design.mesh, cam=cam)
     (stl,) = [p for p in write_meshes(folder, solid, ["stl"]) if p.suffix == ".stl"]
     return Built(
         name=request.param,
@@ -82,8 +82,12 @@ def built(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFacto
         fit=fit,
         solid=solid,
         folder=folder,
-        dxf=write_profile_dxf(folder / "profile.dxf", cam=cam, fit=fit, design=design),
-        poly_dxf=write_profile_poly_dxf(folder / "profile_poly.dxf", cam=cam, fit=fit, design=design),
+        dxf=write_profile_dxf(
+            folder / "profile.dxf", cam=cam, fit=fit, plate=design.plate(), options=design.dxf
+        ),
+        poly_dxf=write_profile_poly_dxf(
+            folder / "profile_poly.dxf", cam=cam, fit=fit, plate=design.plate(), options=design.dxf
+        ),
         stl=stl,
     )
 
