@@ -8,7 +8,8 @@ from typing import Any
 
 import pytest
 
-from camcad.design import _SECTIONS, DynamicsModel, FollowerKind, Rotation, load_design, parse_design
+from camcad.design import DynamicsModel, FollowerKind, Rotation, load_design, parse_design
+from camcad.design.schema import _SECTIONS
 from camcad.errors import DesignError
 from tests.conftest import SAMPLES
 

@@ -1,4 +1,4 @@
-"""The design file: its schema, defaults and validation with field paths.
+"""The design file's schema: one rule per key, validation with field paths, and loading.
 
 A design is a TOML file with the tables ``[cam]``, ``[follower]``,
 ``[[motion]]``, ``[dynamics]``, ``[fit]``, ``[dxf]``, ``[mesh]``, ``[tables]``
@@ -28,15 +28,15 @@ import re
 import reprlib
 import sys
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from camcad.dynamics.spec import DynamicsModel, DynamicsSetup, DynamicsSpec
+from camcad.design.spec import DEG, CamSpec, Design, Dialect, Direction, GcodeSpec
+from camcad.dynamics.spec import DynamicsModel, DynamicsSpec
 from camcad.errors import DesignError
 from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fit.spec import FitSpec
-from camcad.geometry.plate import BoreOutline, Plate
 from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
 from camcad.motion.laws import LAWS, make_law
 from camcad.motion.segments import SegmentKind, SegmentSpec
@@ -46,150 +46,11 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - exercised on Python 3.10 only
     import tomli as tomllib
 
-__all__ = [
-    "CamSpec",
-    "Design",
-    "Dialect",
-    "Direction",
-    "DxfSpec",
-    "DynamicsModel",
-    "DynamicsSpec",
-    "FitSpec",
-    "FollowerKind",
-    "FollowerSpec",
-    "GcodeSpec",
-    "MeshSpec",
-    "Rotation",
-    "SegmentKind",
-    "SegmentSpec",
-    "TablesSpec",
-    "load_design",
-    "parse_design",
-]
+__all__ = ["load_design", "parse_design"]
 
-DEG = math.pi / 180.0
 FULL_TURN_DEG = 360.0
 ANGLE_SUM_TOL_DEG = 1e-9
 LIFT_CLOSE_TOL_MM = 1e-9
-
-
-class Dialect(enum.Enum):
-    """G-code dialects."""
-
-    LINUXCNC = "linuxcnc"
-    GRBL = "grbl"
-    GENERIC = "generic"
-
-
-class Direction(enum.Enum):
-    """Milling direction."""
-
-    CLIMB = "climb"
-    CONVENTIONAL = "conventional"
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class CamSpec:
-    """The cam plate. Lengths mm; ``max_pressure_angle`` and ``sample_step`` rad."""
-
-    name: str = "cam"
-    base_radius: float
-    rotation: Rotation = Rotation.CCW
-    speed_rpm: float = 100.0
-    thickness: float = 10.0
-    bore: float = 0.0  # bore diameter [mm]; 0: no bore
-    keyway_width: float = 0.0
-    keyway_depth: float = 0.0
-    max_pressure_angle: float = 30.0 * DEG
-    min_curvature_radius: float | None = None  # mm; None: 0 for roller, 1 mm for flat
-    sample_step: float = 0.1 * DEG
-
-    @property
-    def omega(self) -> float:
-        """Cam angular speed ω [rad/s]."""
-        return self.speed_rpm * 2.0 * math.pi / 60.0
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class GcodeSpec:
-    """Milling settings. Lengths mm, feeds mm/min, ``start_angle`` rad."""
-
-    tool_diameter: float = 6.0
-    tool_number: int = 1
-    tolerance: float = 0.005
-    dialect: Dialect = Dialect.LINUXCNC
-    direction: Direction = Direction.CLIMB
-    stock_to_leave: float = 0.2
-    step_down: float = 2.0
-    breakthrough: float = 0.5
-    lead_radius: float | None = None  # None: the tool diameter
-    start_angle: float = 0.0
-    tab_count: int = 0
-    tab_width: float = 6.0
-    tab_height: float = 1.0
-    clearance_height: float = 10.0
-    safe_height: float = 2.0
-    feed: float = 600.0
-    plunge_feed: float = 150.0
-    spindle_rpm: float = 10000.0
-    coolant: bool = False
-    mill_bore: bool = False
-
-    @property
-    def tool_radius(self) -> float:
-        """Tool radius [mm]."""
-        return self.tool_diameter / 2.0
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Design:
-    """A validated design: everything camcad needs, in mm and radians."""
-
-    cam: CamSpec
-    follower: FollowerSpec
-    motion: tuple[SegmentSpec, ...]
-    dynamics: DynamicsSpec = field(default_factory=DynamicsSpec)
-    fit: FitSpec = field(default_factory=FitSpec)
-    dxf: DxfSpec = field(default_factory=DxfSpec)
-    mesh: MeshSpec = field(default_factory=MeshSpec)
-    tables: TablesSpec = field(default_factory=TablesSpec)
-    gcode: GcodeSpec = field(default_factory=GcodeSpec)
-    source: str = ""
-
-    def plate(self) -> Plate:
-        """The plate the writers take: name, thickness, bore and keyway."""
-        cam = self.cam
-        return Plate(
-            name=cam.name,
-            thickness=cam.thickness,
-            bore=BoreOutline.from_cam_spec(cam.bore, cam.keyway_width, cam.keyway_depth),
-        )
-
-    def dynamics_setup(self) -> DynamicsSetup:
-        """The dynamics stage's options: ``[dynamics]`` with the speed and contact geometry it uses."""
-        dyn, cam, fol = self.dynamics, self.cam, self.follower
-        roller = fol.kind is FollowerKind.TRANSLATING_ROLLER
-        return DynamicsSetup(
-            spec=dyn,
-            omega=cam.omega,
-            base_radius=cam.base_radius,
-            contact_length=dyn.contact_width if dyn.contact_width is not None else cam.thickness,
-            roller_radius=fol.roller_radius if roller else 0.0,
-            # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
-            tappet_offset=fol.offset if cam.rotation is Rotation.CCW else -fol.offset,
-        )
-
-    def with_base_radius(self, base_radius: float) -> Design:
-        """The same design with another base radius [mm]."""
-        return replace(self, cam=replace(self.cam, base_radius=base_radius))
-
-    @property
-    def min_curvature_radius(self) -> float:
-        """Required smallest convex profile radius [mm] (0 roller, 1 flat by default)."""
-        if self.cam.min_curvature_radius is not None:
-            return self.cam.min_curvature_radius
-        return 1.0 if self.follower.kind is FollowerKind.TRANSLATING_FLAT else 0.0
-
 
 # ---------------------------------------------------------------------------
 # schema: one rule per key; the rule converts and checks the TOML value
@@ -201,7 +62,6 @@ Check = Callable[[Any], str | None]
 @dataclass(frozen=True, slots=True)
 class _Rule:
     kind: str  # "float", "int", "bool", "str", "enum", "strlist"
-    default: Any = None
     required: bool = False
     check: Check | None = None
     scale: float = 1.0  # multiply floats by this (degrees -> rad)
@@ -345,91 +205,91 @@ def _mesh_formats(v: list[str]) -> str | None:
 
 _SECTIONS: dict[str, dict[str, _Rule]] = {
     "cam": {
-        "name": _Rule("str", "cam", check=_name),
+        "name": _Rule("str", check=_name),
         "base_radius": _Rule(
             "float", required=True, check=_between(MIN_BASE_RADIUS_MM, MAX_LENGTH_MM, " mm")
         ),
-        "rotation": _Rule("enum", Rotation.CCW, enum=Rotation),
-        "speed_rpm": _Rule("float", 100.0, check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
-        "thickness": _Rule("float", 10.0, check=_length),
-        "bore": _Rule("float", 0.0, check=_length_or_zero),
-        "keyway_width": _Rule("float", 0.0, check=_length_or_zero),
-        "keyway_depth": _Rule("float", 0.0, check=_length_or_zero),
-        "max_pressure_angle": _Rule("float", 30.0, check=_below(90.0, "degrees"), scale=DEG),
-        "min_curvature_radius": _Rule("float", None, check=_between(0.0, MAX_LENGTH_MM, " mm")),
-        "sample_step_deg": _Rule("float", 0.1, check=_sample_step, scale=DEG, attr="sample_step"),
+        "rotation": _Rule("enum", enum=Rotation),
+        "speed_rpm": _Rule("float", check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "thickness": _Rule("float", check=_length),
+        "bore": _Rule("float", check=_length_or_zero),
+        "keyway_width": _Rule("float", check=_length_or_zero),
+        "keyway_depth": _Rule("float", check=_length_or_zero),
+        "max_pressure_angle": _Rule("float", check=_below(90.0, "degrees"), scale=DEG),
+        "min_curvature_radius": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "sample_step_deg": _Rule("float", check=_sample_step, scale=DEG, attr="sample_step"),
     },
     "follower": {
-        "type": _Rule("enum", FollowerKind.TRANSLATING_ROLLER, enum=FollowerKind, attr="kind"),
-        "roller_radius": _Rule("float", 0.0, check=_length_or_zero),
-        "offset": _Rule("float", 0.0, check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm")),
-        "face_width": _Rule("float", None, check=_length),
-        "face_margin": _Rule("float", 1.0, check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "type": _Rule("enum", enum=FollowerKind, attr="kind"),
+        "roller_radius": _Rule("float", check=_length_or_zero),
+        "offset": _Rule("float", check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm")),
+        "face_width": _Rule("float", check=_length),
+        "face_margin": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
     },
     "dynamics": {
-        "model": _Rule("enum", DynamicsModel.ENERGY, enum=DynamicsModel),
-        "follower_mass": _Rule("float", 0.0, check=_between(0.0, MAX_MASS_KG, " kg")),
-        "spring_rate": _Rule("float", 0.0, check=_between(0.0, MAX_FORCE_N, " N/mm")),
-        "spring_preload": _Rule("float", 0.0, check=_force),
-        "friction_torque": _Rule("float", 0.0, check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N·mm")),
-        "gravity": _Rule("bool", True),
-        "min_contact_force": _Rule("float", 0.0, check=_force),
-        "f1": _Rule("float", 0.0, check=_fraction),
-        "f2": _Rule("float", 0.0, check=_fraction),
-        "f3": _Rule("float", 0.0, check=_fraction),
-        "a_m": _Rule("float", 0.0, check=_between(0.0, MAX_LENGTH_MM, " mm")),
-        "b_m": _Rule("float", 0.0, check=_between(0.0, MAX_LENGTH_MM, " mm")),
-        "wire_diameter": _Rule("float", None, check=_length),
-        "coil_diameter": _Rule("float", None, check=_length),
-        "active_coils": _Rule("float", None, check=_between(0.5, 1e4, " coils")),
-        "shear_modulus": _Rule("float", None, check=_modulus),
-        "preload_deflection": _Rule("float", None, check=_between(0.0, MAX_LENGTH_MM, " mm")),
-        "contact_width": _Rule("float", None, check=_length),
-        "cam_modulus": _Rule("float", 206000.0, check=_modulus),
-        "cam_poisson": _Rule("float", 0.3, check=_poisson),
-        "follower_modulus": _Rule("float", 206000.0, check=_modulus),
-        "follower_poisson": _Rule("float", 0.3, check=_poisson),
-        "allowable_stress": _Rule("float", None, check=_modulus),
+        "model": _Rule("enum", enum=DynamicsModel),
+        "follower_mass": _Rule("float", check=_between(0.0, MAX_MASS_KG, " kg")),
+        "spring_rate": _Rule("float", check=_between(0.0, MAX_FORCE_N, " N/mm")),
+        "spring_preload": _Rule("float", check=_force),
+        "friction_torque": _Rule("float", check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N·mm")),
+        "gravity": _Rule("bool"),
+        "min_contact_force": _Rule("float", check=_force),
+        "f1": _Rule("float", check=_fraction),
+        "f2": _Rule("float", check=_fraction),
+        "f3": _Rule("float", check=_fraction),
+        "a_m": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "b_m": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "wire_diameter": _Rule("float", check=_length),
+        "coil_diameter": _Rule("float", check=_length),
+        "active_coils": _Rule("float", check=_between(0.5, 1e4, " coils")),
+        "shear_modulus": _Rule("float", check=_modulus),
+        "preload_deflection": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "contact_width": _Rule("float", check=_length),
+        "cam_modulus": _Rule("float", check=_modulus),
+        "cam_poisson": _Rule("float", check=_poisson),
+        "follower_modulus": _Rule("float", check=_modulus),
+        "follower_poisson": _Rule("float", check=_poisson),
+        "allowable_stress": _Rule("float", check=_modulus),
     },
     "fit": {
-        "tolerance": _Rule("float", 1e-3, check=_between(MIN_FIT_TOL_MM, MAX_TOLERANCE_MM, " mm")),
+        "tolerance": _Rule("float", check=_between(MIN_FIT_TOL_MM, MAX_TOLERANCE_MM, " mm")),
         "max_control_points": _Rule(
-            "int", None, check=lambda v: None if 8 <= v <= 100_000 else "must be in [8, 100000]"
+            "int", check=lambda v: None if 8 <= v <= 100_000 else "must be in [8, 100000]"
         ),
     },
     "dxf": {
-        "pitch_curve": _Rule("bool", True),
-        "chord_tolerance": _Rule("float", 0.005, check=_chord_tolerance),
-        "annotate": _Rule("bool", True),
+        "pitch_curve": _Rule("bool"),
+        "chord_tolerance": _Rule("float", check=_chord_tolerance),
+        "annotate": _Rule("bool"),
     },
     "mesh": {
-        "formats": _Rule("strlist", ("stl",), check=_mesh_formats),
-        "chord_tolerance": _Rule("float", 0.005, check=_chord_tolerance),
+        "formats": _Rule("strlist", check=_mesh_formats),
+        "chord_tolerance": _Rule("float", check=_chord_tolerance),
     },
     "tables": {
-        "step_deg": _Rule("float", 1.0, check=_table_step, scale=DEG, attr="step"),
+        "step_deg": _Rule("float", check=_table_step, scale=DEG, attr="step"),
     },
     "gcode": {
-        "tool_diameter": _Rule("float", 6.0, check=_length),
-        "tool_number": _Rule("int", 1, check=_count(1, MAX_TOOL_NUMBER, "a tool-table number")),
-        "tolerance": _Rule("float", 0.005, check=_between(MIN_GCODE_TOL_MM, MAX_TOLERANCE_MM, " mm")),
-        "dialect": _Rule("enum", Dialect.LINUXCNC, enum=Dialect),
-        "direction": _Rule("enum", Direction.CLIMB, enum=Direction),
-        "stock_to_leave": _Rule("float", 0.2, check=_between(0.0, MAX_LENGTH_MM, " mm")),
-        "step_down": _Rule("float", 2.0, check=_length),
-        "breakthrough": _Rule("float", 0.5, check=_between(0.0, MAX_LENGTH_MM, " mm")),
-        "lead_radius": _Rule("float", None, check=_length),
-        "start_angle": _Rule("float", 0.0, check=_between(-360.0, 360.0, " degrees"), scale=DEG),
-        "tab_count": _Rule("int", 0, check=_count(0, MAX_TABS, "tabs around one contour")),
-        "tab_width": _Rule("float", 6.0, check=_length),
-        "tab_height": _Rule("float", 1.0, check=_length),
-        "clearance_height": _Rule("float", 10.0, check=_length),
-        "safe_height": _Rule("float", 2.0, check=_length),
-        "feed": _Rule("float", 600.0, check=_feed),
-        "plunge_feed": _Rule("float", 150.0, check=_feed),
-        "spindle_rpm": _Rule("float", 10000.0, check=_between(1.0, MAX_SPEED_RPM, " rpm")),
-        "coolant": _Rule("bool", False),
-        "mill_bore": _Rule("bool", False),
+        "tool_diameter": _Rule("float", check=_length),
+        "tool_number": _Rule("int", check=_count(1, MAX_TOOL_NUMBER, "a tool-table number")),
+        "tolerance": _Rule("float", check=_between(MIN_GCODE_TOL_MM, MAX_TOLERANCE_MM, " mm")),
+        "dialect": _Rule("enum", enum=Dialect),
+        "direction": _Rule("enum", enum=Direction),
+        "stock_to_leave": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "step_down": _Rule("float", check=_length),
+        "breakthrough": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "lead_radius": _Rule("float", check=_length),
+        "start_angle": _Rule("float", check=_between(-360.0, 360.0, " degrees"), scale=DEG),
+        "tab_count": _Rule("int", check=_count(0, MAX_TABS, "tabs around one contour")),
+        "tab_width": _Rule("float", check=_length),
+        "tab_height": _Rule("float", check=_length),
+        "clearance_height": _Rule("float", check=_length),
+        "safe_height": _Rule("float", check=_length),
+        "feed": _Rule("float", check=_feed),
+        "plunge_feed": _Rule("float", check=_feed),
+        "spindle_rpm": _Rule("float", check=_between(1.0, MAX_SPEED_RPM, " rpm")),
+        "coolant": _Rule("bool"),
+        "mill_bore": _Rule("bool"),
     },
 }
 

@@ -1,0 +1,144 @@
+"""The validated design: every stage's options gathered in one frozen aggregate.
+
+Each stage owns its options (``motion.segments``, ``geometry.spec``,
+``dynamics.spec``, ``fit.spec``, ``export.spec``); :class:`Design` gathers
+them with the cam plate's own values and hands each stage its own small
+object (``Design.plate()``, ``Design.dynamics_setup()``, ``design.fit`` …).
+Defaults are written once, here and in those dataclasses; the schema
+(:mod:`camcad.design.schema`) only converts and checks what the file states.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field, replace
+
+from camcad.dynamics.spec import DynamicsSetup, DynamicsSpec
+from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
+from camcad.fit.spec import FitSpec
+from camcad.geometry.plate import BoreOutline, Plate
+from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
+from camcad.motion.segments import SegmentSpec
+
+__all__ = ["DEG", "CamSpec", "Design", "Dialect", "Direction", "GcodeSpec"]
+
+DEG = math.pi / 180.0
+
+
+class Dialect(enum.Enum):
+    """G-code dialects."""
+
+    LINUXCNC = "linuxcnc"
+    GRBL = "grbl"
+    GENERIC = "generic"
+
+
+class Direction(enum.Enum):
+    """Milling direction."""
+
+    CLIMB = "climb"
+    CONVENTIONAL = "conventional"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CamSpec:
+    """The cam plate. Lengths mm; ``max_pressure_angle`` and ``sample_step`` rad."""
+
+    name: str = "cam"
+    base_radius: float
+    rotation: Rotation = Rotation.CCW
+    speed_rpm: float = 100.0
+    thickness: float = 10.0
+    bore: float = 0.0  # bore diameter [mm]; 0: no bore
+    keyway_width: float = 0.0
+    keyway_depth: float = 0.0
+    max_pressure_angle: float = 30.0 * DEG
+    min_curvature_radius: float | None = None  # mm; None: 0 for roller, 1 mm for flat
+    sample_step: float = 0.1 * DEG
+
+    @property
+    def omega(self) -> float:
+        """Cam angular speed ω [rad/s]."""
+        return self.speed_rpm * 2.0 * math.pi / 60.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GcodeSpec:
+    """Milling settings. Lengths mm, feeds mm/min, ``start_angle`` rad."""
+
+    tool_diameter: float = 6.0
+    tool_number: int = 1
+    tolerance: float = 0.005
+    dialect: Dialect = Dialect.LINUXCNC
+    direction: Direction = Direction.CLIMB
+    stock_to_leave: float = 0.2
+    step_down: float = 2.0
+    breakthrough: float = 0.5
+    lead_radius: float | None = None  # None: the tool diameter
+    start_angle: float = 0.0
+    tab_count: int = 0
+    tab_width: float = 6.0
+    tab_height: float = 1.0
+    clearance_height: float = 10.0
+    safe_height: float = 2.0
+    feed: float = 600.0
+    plunge_feed: float = 150.0
+    spindle_rpm: float = 10000.0
+    coolant: bool = False
+    mill_bore: bool = False
+
+    @property
+    def tool_radius(self) -> float:
+        """Tool radius [mm]."""
+        return self.tool_diameter / 2.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Design:
+    """A validated design: everything camcad needs, in mm and radians."""
+
+    cam: CamSpec
+    follower: FollowerSpec
+    motion: tuple[SegmentSpec, ...]
+    dynamics: DynamicsSpec = field(default_factory=DynamicsSpec)
+    fit: FitSpec = field(default_factory=FitSpec)
+    dxf: DxfSpec = field(default_factory=DxfSpec)
+    mesh: MeshSpec = field(default_factory=MeshSpec)
+    tables: TablesSpec = field(default_factory=TablesSpec)
+    gcode: GcodeSpec = field(default_factory=GcodeSpec)
+    source: str = ""
+
+    def plate(self) -> Plate:
+        """The plate the writers take: name, thickness, bore and keyway."""
+        cam = self.cam
+        return Plate(
+            name=cam.name,
+            thickness=cam.thickness,
+            bore=BoreOutline.from_cam_spec(cam.bore, cam.keyway_width, cam.keyway_depth),
+        )
+
+    def dynamics_setup(self) -> DynamicsSetup:
+        """The dynamics stage's options: ``[dynamics]`` with the speed and contact geometry it uses."""
+        dyn, cam, fol = self.dynamics, self.cam, self.follower
+        roller = fol.kind is FollowerKind.TRANSLATING_ROLLER
+        return DynamicsSetup(
+            spec=dyn,
+            omega=cam.omega,
+            base_radius=cam.base_radius,
+            contact_length=dyn.contact_width if dyn.contact_width is not None else cam.thickness,
+            roller_radius=fol.roller_radius if roller else 0.0,
+            # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
+            tappet_offset=fol.offset if cam.rotation is Rotation.CCW else -fol.offset,
+        )
+
+    def with_base_radius(self, base_radius: float) -> Design:
+        """The same design with another base radius [mm]."""
+        return replace(self, cam=replace(self.cam, base_radius=base_radius))
+
+    @property
+    def min_curvature_radius(self) -> float:
+        """Required smallest convex profile radius [mm] (0 roller, 1 flat by default)."""
+        if self.cam.min_curvature_radius is not None:
+            return self.cam.min_curvature_radius
+        return 1.0 if self.follower.kind is FollowerKind.TRANSLATING_FLAT else 0.0
