@@ -85,9 +85,12 @@ class PointElement:
 class LineElement:
     """A face line n(θ)·x = p in the machine frame, n(θ) = (cos θ, sin θ) pointing at the follower.
 
-    ``theta`` [rad] and ``p`` [mm], each with its first three φ-derivatives, (n,).
+    ``theta`` [rad] and ``p`` [mm], each with its first three φ-derivatives, (n,);
+    ``normal`` (n, 2) is n(θ) itself, given exactly (e.g. (0, 1) for a face
+    across the y axis, where cos(π/2) would leave a 6e-17 residue).
     """
 
+    normal: FloatArray
     theta: tuple[FloatArray, FloatArray, FloatArray, FloatArray]
     p: tuple[FloatArray, FloatArray, FloatArray, FloatArray]
 
@@ -134,9 +137,8 @@ def line_envelope(phi: FloatArray, element: LineElement, sigma: float) -> tuple[
     ϑ′ = −σ and ρ = r_b + s + d²s/dφ², Hren et al. with the papers/README
     reading).
     """
-    t0, t1, t2, t3 = element.theta
+    _, t1, t2, t3 = element.theta
     p0, p1, p2, p3 = element.p
-    th = t0 - sigma * phi
     w1 = t1 - sigma  # ϑ′, never 0: the face turns relative to the cam
     w2, w3 = t2, t3
     q0 = p1 / w1
@@ -144,7 +146,7 @@ def line_envelope(phi: FloatArray, element: LineElement, sigma: float) -> tuple[
     q2 = (p3 * w1**2 - 2.0 * p2 * w1 * w2 - p1 * w1 * w3 + 2.0 * p1 * w2**2) / w1**3
     rho = p0 + q1 / w1
     drho = p1 + (q2 * w1 - q1 * w2) / w1**2
-    normal = np.column_stack((np.cos(th), np.sin(th)))
+    normal = to_cam(phi, element.normal, sigma)  # n(ϑ) = R(−σφ)·n(θ)
     tang = _quarter(normal)
     point = p0[:, None] * normal + q0[:, None] * tang
     speed = p0 * w1 + q1  # C′ = speed·t

@@ -39,6 +39,7 @@ class TranslatingFlat:
         """θ = π/2 (fixed), p = r_b + s with p′ = v, p″ = a, p‴ = j."""
         zero = np.zeros_like(motion.s)
         return LineElement(
+            normal=np.column_stack((zero, zero + 1.0)),
             theta=(zero + math.pi / 2.0, zero, zero, zero),
             p=(self.base_radius + motion.s, motion.v, motion.a, motion.j),
         )
