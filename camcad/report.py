@@ -26,6 +26,7 @@ import numpy as np
 
 from camcad._plots import Plot, compare_plots, report_plots
 from camcad.export.records import write_text
+from camcad.findings import Finding
 
 if TYPE_CHECKING:
     from camcad.analysis import Analysis
@@ -204,12 +205,26 @@ def _alert(kind: str, title: str, items: Sequence[str], *, anchor: str = "") -> 
     return f'<section class="alert {kind}"{ident}><h2>{_e(title)}</h2>{body}</section>'
 
 
-def _alerts(warnings: Sequence[str], violations: Sequence[str]) -> str:
+def _finding_lines(findings: Sequence[Finding]) -> list[str]:
+    """One line per broken limit: its kind and severity, the field to change, the message."""
+    return [f"{f.kind} ({f.severity.value} limit, {f.field}): {f.message}" for f in findings]
+
+
+def _alerts(analysis: Analysis) -> str:
+    """The banner: hard limits, then soft limits, then notes (see camcad.findings for the rule)."""
+    hard = [f for f in analysis.findings if f.hard]
+    soft = [f for f in analysis.findings if not f.hard]
+    said = {f.message for f in analysis.findings}
+    notes = [w for w in analysis.warnings if w not in said]
     out = []
-    if violations:
-        out.append(_alert("bad", "Design limits violated", violations, anchor="violations"))
-    if warnings:
-        out.append(_alert("warn", f"Warnings ({len(warnings)})", warnings, anchor="warnings"))
+    if hard:
+        out.append(_alert("bad", "Hard limits broken", _finding_lines(hard), anchor="violations"))
+    if soft:
+        out.append(
+            _alert("warn", f"Soft limits broken ({len(soft)})", _finding_lines(soft), anchor="warnings")
+        )
+    if notes:
+        out.append(_alert("warn", f"Notes ({len(notes)})", notes))
     if not out:
         out.append(_alert("ok", "No warnings", ["Every checked limit is met."], anchor="warnings"))
     return "\n".join(out)
@@ -261,8 +276,8 @@ def _card(label: str, value: str, note: str = "", *, over: bool = False) -> str:
 def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
     cam = analysis.cam
     follower = f"roller r = {cam.roller_radius:g} mm" if cam.is_roller else "flat-face follower"
-    if cam.offset_e:
-        follower += f", offset {cam.offset_e:g} mm"
+    if cam.eccentricity:
+        follower += f", offset {cam.eccentricity:g} mm"
     alpha_over = k["alpha"] > k["alpha_limit"]
     alpha_note = f"limit {k['alpha_limit']:.2f}°"
     if k["alpha_at"] is not None:
@@ -335,7 +350,7 @@ def _design_table(analysis: Analysis) -> str:
         ("follower", design.follower.kind.value),
         ("base radius [mm]", _num(spec.base_radius)),
         ("roller radius [mm]", _num(cam.roller_radius) if cam.is_roller else _DASH),
-        ("follower offset [mm]", _num(cam.offset_e)),
+        ("follower offset [mm]", _num(cam.eccentricity)),
         ("rotation", spec.rotation.value),
         ("speed [rpm]", _num(spec.speed_rpm)),
         ("thickness [mm]", _num(spec.thickness)),
@@ -396,7 +411,7 @@ def render_report(analysis: Analysis) -> str:
     body = "\n".join(
         [
             header,
-            _alerts(analysis.warnings, analysis.violations),
+            _alerts(analysis),
             _cards(analysis, _key_numbers(analysis, summary)),
             f'<h2>Plots</h2>\n<section class="plots" id="plots">{plots}</section>',
             "<h2>Tables</h2>",
@@ -475,7 +490,8 @@ def render_compare(analyses: Sequence[Analysis]) -> str:
     rows = [[_e(c) for c in row] for row in table[1:]]
     alerts = []
     for name, analysis in zip(names, analyses, strict=True):
-        findings = [*(f"limit violated: {v}" for v in analysis.violations), *analysis.warnings]
+        said = {f.message for f in analysis.findings}
+        findings = [*_finding_lines(analysis.findings), *(w for w in analysis.warnings if w not in said)]
         if findings:
             alerts.append(_alert("bad" if analysis.violations else "warn", name, findings))
     if not alerts:

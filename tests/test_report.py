@@ -141,7 +141,8 @@ def test_report_lists_every_warning_escaped(warned):
     assert warned.design.cam.name in parsed.plain
     for warning in warned.warnings:
         assert " ".join(warning.split()) in parsed.plain
-    assert "Design limits violated" in parsed.plain
+    assert "Soft limits broken (1)" in parsed.plain  # the pressure angle, a soft limit
+    assert "pressure angle (soft limit, cam.max_pressure_angle)" in parsed.plain
     # the warnings come before the plots
     assert page.index('id="warnings"') < page.index('id="plots"')
     assert "not run" in parsed.plain  # no fit

@@ -222,7 +222,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
     "follower": {
         "type": _Rule("enum", enum=FollowerKind, attr="kind"),
         "roller_radius": _Rule("float", check=_length_or_zero),
-        "offset": _Rule("float", check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm")),
+        "offset": _Rule("float", check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm"), attr="eccentricity"),
         "face_width": _Rule("float", check=_length),
         "face_margin": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
     },
@@ -476,10 +476,10 @@ def _check_design(design: Design) -> None:
                 f"{fol.roller_radius:g} must be > 0 for a translating-roller follower "
                 f"(allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
             )
-        if abs(fol.offset) >= cam.base_radius + fol.roller_radius:
+        if abs(fol.eccentricity) >= cam.base_radius + fol.roller_radius:
             raise DesignError(
                 "follower.offset",
-                f"|{fol.offset:g}| must be smaller than base_radius + roller_radius = "
+                f"|{fol.eccentricity:g}| must be smaller than base_radius + roller_radius = "
                 f"{cam.base_radius + fol.roller_radius:g} mm",
             )
     if cam.bore / 2.0 >= cam.base_radius:

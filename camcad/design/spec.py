@@ -129,7 +129,7 @@ class Design:
             contact_length=dyn.contact_width if dyn.contact_width is not None else cam.thickness,
             roller_radius=fol.roller_radius if roller else 0.0,
             # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
-            tappet_offset=fol.offset if cam.rotation is Rotation.CCW else -fol.offset,
+            tappet_offset=fol.eccentricity if cam.rotation is Rotation.CCW else -fol.eccentricity,
         )
 
     def with_base_radius(self, base_radius: float) -> Design:

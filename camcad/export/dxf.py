@@ -190,7 +190,7 @@ def _annotation_lines(cam: Cam, plate: Plate, fit: ProfileFit) -> list[str]:
     lines = [
         f"CAM {plate.name}",
         sizes,
-        f"follower {follower.kind.value}, {who}, offset {follower.offset:.3f} mm, "
+        f"follower {follower.kind.value}, {who}, offset {follower.eccentricity:.3f} mm, "
         f"rotation {cam.rotation.value}",
     ]
     for seg in cam.program.segments:

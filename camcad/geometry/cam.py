@@ -37,9 +37,9 @@ def follower_from_spec(spec: FollowerSpec, base_radius: float) -> Follower:
     """The follower module a design's ``[follower]`` table describes, at base radius r_b [mm]."""
     if spec.kind is FollowerKind.TRANSLATING_ROLLER:
         return TranslatingRoller(
-            base_radius=base_radius, roller_radius=spec.roller_radius, eccentricity=spec.offset
+            base_radius=base_radius, roller_radius=spec.roller_radius, eccentricity=spec.eccentricity
         )
-    return TranslatingFlat(base_radius=base_radius, eccentricity=spec.offset)
+    return TranslatingFlat(base_radius=base_radius, eccentricity=spec.eccentricity)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -119,9 +119,9 @@ class Cam:
         return self.kinematics.roller_radius
 
     @property
-    def offset_e(self) -> float:
-        """Follower eccentricity (offset) e [mm]: its axis is the line x = e."""
-        return self.follower.offset
+    def eccentricity(self) -> float:
+        """Follower eccentricity e [mm] (the design file's ``offset``): its axis is the line x = e."""
+        return self.follower.eccentricity
 
     @property
     def sigma(self) -> float:
@@ -211,7 +211,7 @@ class Cam:
             base=base,
             profile=profile,
             pressure_angle=alpha,
-            contact_x=contact[:, 0] - self.offset_e,
+            contact_x=contact[:, 0] - self.eccentricity,
         )
 
     def pressure_angle(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
@@ -237,6 +237,6 @@ class Cam:
         """
         profile = self.profile(phi, side=side)
         contact = to_cam(profile.phi, profile.point, -self.sigma)
-        out = contact[:, 0] - self.offset_e
+        out = contact[:, 0] - self.eccentricity
         readonly(out)
         return out

@@ -105,7 +105,7 @@ def min_base_radius(
     is returned.
     """
     phi = cam.sample_phi(step)
-    lo = max(abs(cam.offset_e) - cam.roller_radius, 0.0) + _RADIUS_TOL_MM
+    lo = max(abs(cam.eccentricity) - cam.roller_radius, 0.0) + _RADIUS_TOL_MM
 
     def at(radius: float) -> Cam:
         return replace(cam, base_radius=radius)

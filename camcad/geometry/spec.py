@@ -28,6 +28,8 @@ class FollowerSpec:
 
     kind: FollowerKind = FollowerKind.TRANSLATING_ROLLER
     roller_radius: float = 0.0
-    offset: float = 0.0  # e > 0 puts the follower axis at x = +e, whatever the rotation
+    eccentricity: float = (
+        0.0  # e [mm]: the follower axis is the line x = e, whatever the rotation (TOML: offset)
+    )
     face_width: float | None = None
     face_margin: float = 1.0  # mm beyond the contact's travel at each edge of a flat face

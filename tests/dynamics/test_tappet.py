@@ -74,7 +74,7 @@ def tappet_of(design: Design) -> GuidedTappet:
         f1=d.f1,
         f2=d.f2,
         f3=d.f3,
-        offset=design.follower.offset,
+        offset=design.follower.eccentricity,
     )
 
 

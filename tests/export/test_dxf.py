@@ -189,7 +189,7 @@ def test_centre_lines_and_pitch_curve(case, written):
     radius = np.hypot(pts[:, 0], pts[:, 1])
     prime = design.cam.base_radius + design.follower.roller_radius
     assert radius.max() == pytest.approx(np.hypot(exact[:, 0], exact[:, 1]).max(), abs=1e-3)
-    assert radius.min() >= np.sqrt(prime**2 - design.follower.offset**2) - 1e-9
+    assert radius.min() >= np.sqrt(prime**2 - design.follower.eccentricity**2) - 1e-9
 
 
 def test_pitch_curve_and_annotation_can_be_switched_off(case):

@@ -20,7 +20,7 @@ LAWS = ["harmonic", "cycloidal", "poly-345", "poly-4567", "modified-sine"]
 def pitch_002(cam: Cam, phi: np.ndarray) -> np.ndarray:
     """Quang & Hung 2015, eq. 2 with the erratum, written out independently."""
     m = cam.motion(phi)
-    e, r = cam.offset_e, cam.base_radius + cam.roller_radius
+    e, r = cam.eccentricity, cam.base_radius + cam.roller_radius
     k = math.sqrt(r**2 - e**2)
     x = (k + m.s) * np.sin(phi) + e * np.cos(phi)
     y = (k + m.s) * np.cos(phi) - e * np.sin(phi)

@@ -62,7 +62,7 @@ def test_pressure_angle_is_quang_eq_4_and_offsets_shift_curvature_exactly(d):
     cam = build(d)
     phi = np.linspace(0, 2 * math.pi, 181)
     m = cam.motion(phi)
-    e = cam.offset_e
+    e = cam.eccentricity
     k = math.sqrt((cam.base_radius + cam.roller_radius) ** 2 - e**2)
     assert_allclose(cam.pressure_angle(phi), np.arctan((m.v - e) / (m.s + k)), atol=1e-12)
     for distance in (0.0, 3.0):
