@@ -24,6 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle, FancyArrowPatch, Polygon
 
 from camcad._typing import FloatArray
+from camcad.geometry.envelope import to_cam
 
 if TYPE_CHECKING:
     from camcad.analysis import Analysis
@@ -260,23 +261,17 @@ def _bore_outline(bore: float, width: float, depth: float) -> FloatArray:
     return np.vstack((arc, top))
 
 
-def _rotate(phi: float, local: FloatArray, sign: float) -> FloatArray:
-    """Follower-frame vectors (n, 2) into the cam frame; see ``camcad.geometry.curves.rotate_to_cam``."""
-    c, s = math.cos(phi), math.sin(phi)
-    x = local[:, 0] * c + local[:, 1] * s
-    y = -local[:, 0] * s + local[:, 1] * c
-    return np.column_stack((sign * x, y))
-
-
 def _draw_followers(ax: Axes, analysis: Analysis, reach: float) -> float:
     """Draw the follower at :data:`FOLLOWER_ANGLES_DEG` in the cam frame (kinematic inversion).
 
     Returns the largest distance of a stem tip from the cam centre [mm].
     """
     cam, geo = analysis.cam, analysis.geometry
-    sign = 1.0 if cam.rotation.value == "ccw" else -1.0
     phis = np.radians(np.asarray(FOLLOWER_ANGLES_DEG))
-    centres = np.asarray(cam.pitch(phis).point)
+    follower = cam.kinematics  # the drawing asks the follower, not a kind flag
+    trace = follower.trace(cam.motion(phis)).m0  # machine frame
+    centres = to_cam(phis, trace, cam.sigma)
+    axes = to_cam(phis, follower.guide.driven(trace), cam.sigma)  # the direction it is driven in
     stem = 0.25 * reach
     far = reach
     if cam.is_roller:
@@ -284,9 +279,9 @@ def _draw_followers(ax: Axes, analysis: Analysis, reach: float) -> float:
     else:
         width = analysis.design.follower.face_width
         half_face = 0.5 * width if width else 0.6 * (geo.face_width_min or cam.base_radius)
-    for k, (phi, centre) in enumerate(zip(phis, centres, strict=True)):
+    for k, (phi, centre, axis_dir) in enumerate(zip(phis, centres, axes, strict=True)):
         color = _COLORS[(k + 1) % len(_COLORS)]
-        axis_dir, across = _rotate(float(phi), np.array([[0.0, 1.0], [1.0, 0.0]]), sign)
+        across = np.array([axis_dir[1], -axis_dir[0]])
         if cam.is_roller:
             r = cam.roller_radius
             ax.add_patch(Circle(tuple(centre), r, fill=False, edgecolor=color, linewidth=1.4))

@@ -13,7 +13,7 @@ import numpy as np
 
 from camcad._typing import FloatArray, readonly
 
-__all__ = ["CurveSample", "curve_sample", "rotate_to_cam"]
+__all__ = ["CurveSample", "curve_sample"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -91,26 +91,3 @@ def curve_sample(
     )
     readonly(out.point, out.d1, out.d2, out.tangent, out.normal, out.rho)
     return out
-
-
-def rotate_to_cam(phi: FloatArray, local: FloatArray, sign: float = 1.0) -> FloatArray:
-    """Rotate follower-frame vectors into the cam frame.
-
-    The follower frame turns with the cam angle: its y axis is the follower's
-    direction of travel. For a counter-clockwise cam (``sign = +1``) the
-    cam-frame vector is R(−φ)·local, so at φ = 0 the follower stands on +y
-    (Quintero & Vanegas 2016, eq. 11; Quang & Hung 2015, eq. 2 with erratum).
-
-    Parameters
-    ----------
-    phi
-        (n,) cam angle [rad].
-    local
-        (n, 2) vectors in the follower frame.
-    sign
-        +1 for counter-clockwise rotation; −1 mirrors about the y axis (cw).
-    """
-    c, s = np.cos(phi), np.sin(phi)
-    x = local[:, 0] * c + local[:, 1] * s
-    y = -local[:, 0] * s + local[:, 1] * c
-    return np.column_stack((sign * x, y))
