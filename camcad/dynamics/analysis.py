@@ -214,24 +214,7 @@ def analyse_dynamics(
     spring_preload = spring_from_spec(dyn).preload
 
     def rows(r: _Pointwise) -> FloatArray:
-        """Every quantity whose extreme is reported, one row each (kinds in ``_KINDS``)."""
-        need_speed = margin * r.ratio - r.static  # A·ω² ≥ margin·c − B bounds ω² (jump.speed_limits)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            bound = need_speed / r.inertia
-        return np.vstack(
-            (
-                r.force,
-                r.force,
-                r.torque,
-                r.torque,
-                r.stress,
-                # F0* = max(margin·c − A·ω² − (B − F0)) (jump.min_preload, at the true maximum)
-                margin * r.ratio - r.inertia * omega**2 - (r.static - spring_preload),
-                np.where(r.inertia == 0.0, need_speed, -np.inf),  # where A = 0, B ≥ margin·c is needed
-                np.where(r.inertia < 0.0, bound, np.inf),  # ω² ≤ min over A < 0
-                np.where(r.inertia > 0.0, bound, -np.inf),  # ω² ≥ max over A > 0
-            )
-        )
+        return _reported(r, margin=margin, omega=omega, preload=spring_preload)
 
     values = rows(sampled)
     if cam is None:
@@ -253,22 +236,7 @@ def analyse_dynamics(
         window = speed_window(max(lower.value, 0.0), upper.value)
         speeds = None if window is None else (window[0] * _RAD_S_TO_RPM, window[1] * _RAD_S_TO_RPM)
 
-    warnings: list[str] = []
-    if sampled.near is not None and sampled.far is not None:
-        for name, guide, f in (("N2", sampled.near, dyn.f2), ("N3", sampled.far, dyn.f3)):
-            # eq. 25 keeps the guide sides of Fig. 2; where N < 0 its friction points the
-            # wrong way, an error of 2·f·|N| along the axis: flag it above 1 % of N1.
-            misdirected = (guide < 0.0) & (2.0 * f * np.abs(guide) > _GUIDE_FLIP_RTOL * np.abs(sampled.force))
-            flipped = loss_runs(motion.phi, misdirected)
-            if flipped:
-                arc = covering_arc(flipped)
-                assert arc is not None
-                warnings.append(
-                    f"guide force {name} changes side {_arc_text(arc)}: Hren et al. eq. 25 "
-                    "assumes the guide contacts of its Fig. 2, so the guide friction there "
-                    "is approximate"
-                )
-
+    warnings = _guide_notes(phi, sampled, dyn)
     runs = loss_runs(motion.phi, sampled.force < margin)
     if not runs and force_min.value < margin:  # lost only between samples or just before/after a joint
         runs = ((force_min.phi % TWO_PI, force_min.phi % TWO_PI),)
@@ -283,38 +251,24 @@ def analyse_dynamics(
             speeds=speeds,
             worst=force_min,
         )
-        warnings.insert(0, message)
-        findings.append(
-            Finding(
-                kind="jump",
-                severity=Severity.SOFT,
-                field="dynamics.spring_preload",
-                message=message,
-                angle=force_min.phi,
-                value=force_min.value,
-                limit=margin,
-                unit="N",
-            )
-        )
+        findings.append(_limit("jump", "dynamics.spring_preload", message, force_min, margin, "N"))
     if dyn.allowable_stress is not None and stress_max.value > dyn.allowable_stress:
         message = (
             f"Hertz contact stress reaches {stress_max.value:.1f} MPa {stress_max.where()}, above the "
             f"allowable {dyn.allowable_stress:g} MPa: widen the contact, enlarge the roller or the "
             "base circle, or lower the spring load"
         )
-        warnings.append(message)
         findings.append(
-            Finding(
-                kind="contact stress",
-                severity=Severity.SOFT,
-                field="dynamics.allowable_stress",
-                message=message,
-                angle=stress_max.phi,
-                value=stress_max.value,
-                limit=dyn.allowable_stress,
-                unit="MPa",
+            _limit(
+                "contact stress",
+                "dynamics.allowable_stress",
+                message,
+                stress_max,
+                dyn.allowable_stress,
+                "MPa",
             )
         )
+    warnings = [f.message for f in findings] + warnings
     torque = np.asarray(sampled.torque, dtype=float)
     readonly(phi, torque)
     return DynamicsResult(
@@ -339,6 +293,68 @@ def analyse_dynamics(
         torque_min=torque_min,
         torque_max=torque_max,
         hertz_stress_max=stress_max,
+    )
+
+
+def _reported(r: _Pointwise, *, margin: float, omega: float, preload: float) -> FloatArray:
+    """Every quantity whose extreme analyse_dynamics reports, one row each (kinds in ``_KINDS``).
+
+    Contact force (min, max), torque (min, max), Hertz stress (max); the
+    preload need F0* = max(margin·c − A·ω² − (B − F0)) (jump.min_preload); and
+    the three speed bounds of jump.speed_limits: where A = 0 the need
+    margin·c − B must be ≤ 0, ω² ≤ (margin·c − B)/A where A < 0 (its min),
+    ω² ≥ (margin·c − B)/A where A > 0 (its max).
+    """
+    need_speed = margin * r.ratio - r.static
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bound = need_speed / r.inertia
+    return np.vstack(
+        (
+            r.force,
+            r.force,
+            r.torque,
+            r.torque,
+            r.stress,
+            margin * r.ratio - r.inertia * omega**2 - (r.static - preload),
+            np.where(r.inertia == 0.0, need_speed, -np.inf),
+            np.where(r.inertia < 0.0, bound, np.inf),
+            np.where(r.inertia > 0.0, bound, -np.inf),
+        )
+    )
+
+
+def _guide_notes(phi: FloatArray, sampled: _Pointwise, dyn: DynamicsSpec) -> list[str]:
+    """Notes where the guided tappet's guide forces change side (eq. 25's friction is then approximate)."""
+    notes: list[str] = []
+    if sampled.near is None or sampled.far is None:
+        return notes
+    for name, guide, f in (("N2", sampled.near, dyn.f2), ("N3", sampled.far, dyn.f3)):
+        # eq. 25 keeps the guide sides of Fig. 2; where N < 0 its friction points the
+        # wrong way, an error of 2·f·|N| along the axis: flag it above 1 % of N1.
+        misdirected = (guide < 0.0) & (2.0 * f * np.abs(guide) > _GUIDE_FLIP_RTOL * np.abs(sampled.force))
+        flipped = loss_runs(phi, misdirected)
+        if flipped:
+            arc = covering_arc(flipped)
+            assert arc is not None
+            notes.append(
+                f"guide force {name} changes side {_arc_text(arc)}: Hren et al. eq. 25 "
+                "assumes the guide contacts of its Fig. 2, so the guide friction there "
+                "is approximate"
+            )
+    return notes
+
+
+def _limit(kind: str, field: str, message: str, worst: Extreme, limit: float, unit: str) -> Finding:
+    """A soft finding of the dynamics (follower jump, contact stress)."""
+    return Finding(
+        kind=kind,
+        severity=Severity.SOFT,
+        field=field,
+        message=message,
+        angle=worst.phi,
+        value=worst.value,
+        limit=limit,
+        unit=unit,
     )
 
 

@@ -147,6 +147,52 @@ def _bad_range(quantity: Quantity, limit: float, worst: Extreme, step: float) ->
     return float(np.mod(lo, TWO_PI)), float(np.mod(hi, TWO_PI)) if hi < TWO_PI else TWO_PI
 
 
+def _pressure_finding(phi: FloatArray, alpha: FloatArray, worst: Extreme, limit: float) -> Finding:
+    """The soft finding for a pressure angle over ``limit`` [rad], with the ranges where it is."""
+    ranges = flagged_ranges(phi, np.abs(alpha) > limit)
+    where = format_ranges(ranges) if ranges else worst.where()
+    return Finding(
+        kind="pressure angle",
+        severity=Severity.SOFT,
+        field="cam.max_pressure_angle",
+        message=(
+            f"pressure angle reaches {math.degrees(worst.value):.2f}° > limit "
+            f"{math.degrees(limit):g}° at {where}"
+        ),
+        angle=worst.phi,
+        value=math.degrees(worst.value),
+        limit=math.degrees(limit),
+        unit="deg",
+    )
+
+
+def _face_check(
+    reach_min: Extreme, reach_max: Extreme, face_width: float | None, face_margin: float
+) -> tuple[float, list[Finding]]:
+    """The face width needed [mm] (travel + margin each side), and a hard finding if the face is narrower."""
+    far = reach_max if abs(reach_max.value) >= abs(reach_min.value) else reach_min
+    reach = abs(far.value)
+    needed = 2.0 * (reach + face_margin)
+    if face_width is None or face_width >= needed:
+        return needed, []
+    message = (
+        f"follower.face_width: {face_width:g} mm does not cover the contact, which travels "
+        f"{reach:.3f} mm off the follower axis {far.where()}; with face_margin "
+        f"{face_margin:g} mm each side use face_width ≥ {_up(needed):.2f} mm"
+    )
+    found = Finding(
+        kind="face width",
+        severity=Severity.HARD,
+        field="follower.face_width",
+        message=message,
+        angle=far.phi,
+        value=face_width,
+        limit=needed,
+        unit="mm",
+    )
+    return needed, [found]
+
+
 def analyse_geometry(
     cam: Cam,
     *,
@@ -206,46 +252,11 @@ def analyse_geometry(
     )
 
     if alpha_max.value > max_pressure_angle:
-        ranges = flagged_ranges(phi, np.abs(alpha) > max_pressure_angle)
-        where = format_ranges(ranges) if ranges else alpha_max.where()
-        findings.append(
-            Finding(
-                kind="pressure angle",
-                severity=Severity.SOFT,
-                field="cam.max_pressure_angle",
-                message=(
-                    f"pressure angle reaches {math.degrees(alpha_max.value):.2f}° > limit "
-                    f"{math.degrees(max_pressure_angle):g}° at {where}"
-                ),
-                angle=alpha_max.phi,
-                value=math.degrees(alpha_max.value),
-                limit=math.degrees(max_pressure_angle),
-                unit="deg",
-            )
-        )
-
+        findings.append(_pressure_finding(phi, alpha, alpha_max, max_pressure_angle))
     face_min = None
     if not roller:
-        far = reach_max if abs(reach_max.value) >= abs(reach_min.value) else reach_min
-        reach = abs(far.value)
-        face_min = 2.0 * (reach + face_margin)
-        if face_width is not None and face_width < face_min:
-            findings.append(
-                Finding(
-                    kind="face width",
-                    severity=Severity.HARD,
-                    field="follower.face_width",
-                    message=(
-                        f"follower.face_width: {face_width:g} mm does not cover the contact, which travels "
-                        f"{reach:.3f} mm off the follower axis {far.where()}; with face_margin "
-                        f"{face_margin:g} mm each side use face_width ≥ {_up(face_min):.2f} mm"
-                    ),
-                    angle=far.phi,
-                    value=face_width,
-                    limit=face_min,
-                    unit="mm",
-                )
-            )
+        face_min, found = _face_check(reach_min, reach_max, face_width, face_margin)
+        findings += found
 
     quantity, limit = _undercut_quantity(cam)
     undercut = None
