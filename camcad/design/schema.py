@@ -468,6 +468,15 @@ def _check_program(segments: tuple[SegmentSpec, ...]) -> None:
 
 
 def _check_design(design: Design) -> None:
+    """The checks across fields, each naming the field to change."""
+    _check_follower(design)
+    _check_bore(design.cam)
+    _check_dynamics(design)
+    _check_tolerances(design)
+    _check_gcode(design)
+
+
+def _check_follower(design: Design) -> None:
     cam, fol = design.cam, design.follower
     if fol.kind is FollowerKind.TRANSLATING_ROLLER:
         if fol.roller_radius <= 0:
@@ -482,6 +491,9 @@ def _check_design(design: Design) -> None:
                 f"|{fol.eccentricity:g}| must be smaller than base_radius + roller_radius = "
                 f"{cam.base_radius + fol.roller_radius:g} mm",
             )
+
+
+def _check_bore(cam: CamSpec) -> None:
     if cam.bore / 2.0 >= cam.base_radius:
         raise DesignError(
             "cam.bore",
@@ -504,6 +516,10 @@ def _check_design(design: Design) -> None:
             f"{cam.keyway_depth:g} mm takes the keyway to radius {bore_reach:g} mm, outside the base "
             f"circle of radius {cam.base_radius:g} mm; allowed: < {cam.base_radius - cam.bore / 2.0:g} mm",
         )
+
+
+def _check_dynamics(design: Design) -> None:
+    fol = design.follower
     dyn = design.dynamics
     coil = (dyn.wire_diameter, dyn.coil_diameter, dyn.active_coils, dyn.shear_modulus)
     if any(v is not None for v in coil) and any(v is None for v in coil):
@@ -523,6 +539,10 @@ def _check_design(design: Design) -> None:
             raise DesignError("dynamics.model", "'guided-tappet' needs a translating-flat follower")
         if dyn.b_m <= dyn.a_m:
             raise DesignError("dynamics.b_m", f"{dyn.b_m:g} mm must be greater than a_m = {dyn.a_m:g} mm")
+
+
+def _check_tolerances(design: Design) -> None:
+    cam = design.cam
     largest = TOLERANCE_PER_BASE_RADIUS * cam.base_radius
     for path, tol in (
         ("fit.tolerance", design.fit.tolerance),
@@ -536,6 +556,10 @@ def _check_design(design: Design) -> None:
                 f"{tol:g} mm is too coarse for a base radius of {cam.base_radius:g} mm; "
                 f"allowed: ≤ {largest:g} mm ({TOLERANCE_PER_BASE_RADIUS:g} × base_radius)",
             )
+
+
+def _check_gcode(design: Design) -> None:
+    cam = design.cam
     gc = design.gcode
     if gc.safe_height >= gc.clearance_height:
         raise DesignError(
