@@ -323,50 +323,71 @@ def _suggest(key: object, allowed: list[str]) -> str:
     return f"unknown key {_show(key)}{hint} (allowed: {', '.join(allowed)})"
 
 
+def _to_float(path: str, rule: _Rule, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise DesignError(path, f"expected a number, got {_show(value)}")
+    try:
+        out = float(value)
+    except OverflowError:
+        out = math.inf
+    if not math.isfinite(out):
+        raise DesignError(path, f"expected a finite number, got {_show(value)}")
+    return out
+
+
+def _to_int(path: str, rule: _Rule, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise DesignError(path, f"expected a whole number, got {_show(value)}")
+    return int(value)
+
+
+def _to_bool(path: str, rule: _Rule, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise DesignError(path, f"expected true or false, got {_show(value)}")
+    return value
+
+
+def _to_str(path: str, rule: _Rule, value: Any) -> str:
+    if not isinstance(value, str):
+        raise DesignError(path, f"expected a string, got {_show(value)}")
+    return value
+
+
+def _to_strlist(path: str, rule: _Rule, value: Any) -> tuple[str, ...]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise DesignError(path, f"expected a list of strings, got {_show(value)}")
+    return tuple(v.lower() for v in value)
+
+
+def _to_enum(path: str, rule: _Rule, value: Any) -> enum.Enum:
+    assert rule.enum is not None
+    allowed = [m.value for m in rule.enum]
+    if not isinstance(value, str) or value not in allowed:
+        word = value[:100] if isinstance(value, str) else ""
+        close = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise DesignError(path, f"{_show(value)} is not allowed{hint} (allowed: {', '.join(allowed)})")
+    return rule.enum(value)
+
+
+_CONVERTERS: dict[str, Callable[[str, _Rule, Any], Any]] = {
+    "float": _to_float,
+    "int": _to_int,
+    "bool": _to_bool,
+    "str": _to_str,
+    "strlist": _to_strlist,
+    "enum": _to_enum,
+}
+
+
 def _convert(path: str, rule: _Rule, value: Any) -> Any:
-    """Convert one TOML value by its rule, or raise DesignError naming the path."""
-    kind = rule.kind
-    if kind == "float":
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise DesignError(path, f"expected a number, got {_show(value)}")
-        try:
-            out: Any = float(value)
-        except OverflowError:
-            out = math.inf
-        if not math.isfinite(out):
-            raise DesignError(path, f"expected a finite number, got {_show(value)}")
-    elif kind == "int":
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-            raise DesignError(path, f"expected a whole number, got {_show(value)}")
-        out = int(value)
-    elif kind == "bool":
-        if not isinstance(value, bool):
-            raise DesignError(path, f"expected true or false, got {_show(value)}")
-        out = value
-    elif kind == "str":
-        if not isinstance(value, str):
-            raise DesignError(path, f"expected a string, got {_show(value)}")
-        out = value
-    elif kind == "strlist":
-        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-            raise DesignError(path, f"expected a list of strings, got {_show(value)}")
-        out = tuple(v.lower() for v in value)
-    elif kind == "enum":
-        assert rule.enum is not None
-        allowed = [m.value for m in rule.enum]
-        if not isinstance(value, str) or value not in allowed:
-            word = value[:100] if isinstance(value, str) else ""
-            close = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6)
-            hint = f"; did you mean {close[0]!r}?" if close else ""
-            raise DesignError(path, f"{_show(value)} is not allowed{hint} (allowed: {', '.join(allowed)})")
-        out = rule.enum(value)
-    else:  # pragma: no cover - schema error
-        raise AssertionError(kind)
+    """Convert one TOML value by its rule, check it, and scale it; or raise DesignError naming the path."""
+    out = _CONVERTERS[rule.kind](path, rule, value)
     if rule.check is not None:
         problem = rule.check(out)
         if problem:
             raise DesignError(path, f"{_show(value)} {problem}")
-    if kind == "float":
+    if rule.kind == "float":
         out *= rule.scale
     return out
 
