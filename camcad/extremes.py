@@ -208,7 +208,13 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
         f1.append(f_nb if nb_step < 0 else f_end)
         f3.append(f_end if nb_step < 0 else f_nb)
         f2.append(np.full(r.size, np.nan))
-    return _Brackets(*(np.concatenate(a) for a in (out_rows, x1, x2, x3, f1, f2, f3)))
+    def joined(parts: list[FloatArray]) -> FloatArray:
+        out: FloatArray = np.concatenate(parts).astype(float)
+        return out
+
+    return _Brackets(
+        np.concatenate(out_rows), joined(x1), joined(x2), joined(x3), joined(f1), joined(f2), joined(f3)
+    )
 
 
 def _refine_max(f: _Picker, b: _Brackets) -> tuple[FloatArray, FloatArray]:

@@ -291,7 +291,7 @@ def analyse_geometry(
     if undercut is None:
         return analysis
     err = undercut_error(analysis, min_curvature_radius=min_curvature_radius)
-    found = Finding(
+    undercut_finding = Finding(
         kind="undercut" if cam.is_roller else "cusp",
         severity=Severity.HARD,
         field="cam.base_radius",
@@ -301,7 +301,7 @@ def analyse_geometry(
         limit=limit,
         unit="mm",
     )
-    return replace(analysis, findings=(found, *analysis.findings))
+    return replace(analysis, findings=(undercut_finding, *analysis.findings))
 
 
 def _up(value: float) -> float:
