@@ -6,7 +6,7 @@ line-contact stress applies to both. :func:`analyse_dynamics` dispatches on
 ``[dynamics].model``.
 """
 
-from camcad.dynamics.analysis import analyse_dynamics
+from camcad.dynamics.model import analyse_dynamics
 from camcad.dynamics.contact import (
     contact_curvature,
     effective_modulus,
