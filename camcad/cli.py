@@ -145,6 +145,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 def _cmd_size(args: argparse.Namespace) -> int:
     from camcad.design import load_design
+    from camcad.extremes import Extreme
     from camcad.geometry import Cam, min_base_radius
 
     design = load_design(args.design)
@@ -155,7 +156,8 @@ def _cmd_size(args: argparse.Namespace) -> int:
         min_curvature_radius=design.min_curvature_radius,
     )
     print(f"smallest base radius: {result.base_radius:.3f} mm (design has {design.cam.base_radius:g} mm)")
-    print(f"  limited by {result.limit} at cam angle {math.degrees(result.angle):.1f}°")
+    where = Extreme(value=0.0, phi=result.angle, side=result.side).where()
+    print(f"  limited by {result.limit} {where.replace('at ', 'at cam angle ', 1)}")
     print(
         f"  at that radius: max pressure angle {math.degrees(result.pressure_angle_max):.2f}° "
         f"(limit {math.degrees(design.cam.max_pressure_angle):g}°), "

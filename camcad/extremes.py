@@ -208,6 +208,7 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
         f1.append(f_nb if nb_step < 0 else f_end)
         f3.append(f_end if nb_step < 0 else f_nb)
         f2.append(np.full(r.size, np.nan))
+
     def joined(parts: list[FloatArray]) -> FloatArray:
         out: FloatArray = np.concatenate(parts).astype(float)
         return out

@@ -6,7 +6,6 @@ line-contact stress applies to both. :func:`analyse_dynamics` dispatches on
 ``[dynamics].model``.
 """
 
-from camcad.dynamics.model import analyse_dynamics
 from camcad.dynamics.contact import (
     contact_curvature,
     effective_modulus,
@@ -20,6 +19,7 @@ from camcad.dynamics.energy import (
     input_torque,
 )
 from camcad.dynamics.jump import covering_arc, loss_runs, min_preload, speed_limits
+from camcad.dynamics.model import analyse_dynamics
 from camcad.dynamics.results import CSV_HEADER, DynamicsResult
 from camcad.dynamics.spring import Spring, coil_spring_rate, spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, TappetForces, tappet_forces, travel_sign

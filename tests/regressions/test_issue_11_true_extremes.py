@@ -141,3 +141,20 @@ def test_quintero_peak_contact_force_is_the_limit_at_360():
     assert dyn["contact_force_max_side"] == "before joint"
     sampled = analyse_geometry(Cam.from_design(design), max_pressure_angle=1.0)
     assert sampled.phi[-1] < 2 * math.pi  # no sample sits at 360°: only the one-sided limit gives it
+
+
+def test_size_command_says_where_the_limit_is_reached(tmp_path, capsys):
+    from camcad.cli import main
+
+    path = tmp_path / "vap.toml"
+    rise = 'kind = "rise"\nangle = 60.0\nlift = 20.0\nlaw = "vap"\nb = 0.1'
+    ret = rise.replace("rise", "return")
+    dwell = 'kind = "dwell"\nangle = 120.0'
+    path.write_text(
+        "[cam]\nbase_radius = 80.0\n[follower]\nroller_radius = 20.0\n"
+        + "".join(f"[[motion]]\n{seg}\n" for seg in (rise, dwell, ret, dwell))
+    )
+    assert main(["size", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "smallest base radius: 60.137 mm" in out
+    assert "limited by curvature at cam angle 60.0° (just before the joint)" in out
