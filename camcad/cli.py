@@ -93,6 +93,15 @@ def _fmt(value: Any, unit: str = "", digits: int = 3) -> str:
     return f"{value:.{digits}f}{unit}"
 
 
+def _at(section: dict[str, Any], key: str) -> str:
+    """`` at 90.0° (just before the joint)`` for an extreme of ``section``, or ``""``."""
+    angle = section.get(f"{key}_angle_deg")
+    if angle is None:
+        return ""
+    side = section.get(f"{key}_side")
+    return f" at {angle:.1f}°" + (f" (just {side.replace(' joint', ' the joint')})" if side else "")
+
+
 def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
     geo, dyn = summary["geometry"], summary["dynamics"]
     fit = summary.get("fit") or {}
@@ -101,16 +110,23 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
         ("lift", _fmt(summary["motion"]["lift_mm"], " mm")),
         (
             "max pressure angle",
-            f"{_fmt(geo['pressure_angle_max_deg'], '°', 2)} at "
-            f"{_fmt(geo['pressure_angle_max_angle_deg'], '°', 1)} (limit {limit:g}°)",
+            _fmt(geo["pressure_angle_max_deg"], "°", 2)
+            + _at(geo, "pressure_angle_max")
+            + f" (limit {limit:g}°)",
         ),
-        ("min curvature radius", _fmt(geo["curvature_radius_min_mm"], " mm")),
-        ("min concave radius", _fmt(geo["concave_radius_min_mm"], " mm")),
+        (
+            "min curvature radius",
+            _fmt(geo["curvature_radius_min_mm"], " mm") + _at(geo, "curvature_radius_min"),
+        ),
+        ("min concave radius", _fmt(geo["concave_radius_min_mm"], " mm") + _at(geo, "concave_radius_min")),
         ("undercut", _fmt(geo["undercut"])),
-        ("max torque", _fmt(dyn.get("torque_max_Nmm"), " N·mm", 1)),
-        ("max contact force", _fmt(dyn.get("contact_force_max_N"), " N", 2)),
-        ("min contact force", _fmt(dyn.get("contact_force_min_N"), " N", 2)),
-        ("max contact stress", _fmt(dyn.get("hertz_stress_max_MPa"), " MPa", 1)),
+        ("max torque", _fmt(dyn.get("torque_max_Nmm"), " N·mm", 1) + _at(dyn, "torque_max")),
+        ("max contact force", _fmt(dyn.get("contact_force_max_N"), " N", 2) + _at(dyn, "contact_force_max")),
+        ("min contact force", _fmt(dyn.get("contact_force_min_N"), " N", 2) + _at(dyn, "contact_force_min")),
+        (
+            "max contact stress",
+            _fmt(dyn.get("hertz_stress_max_MPa"), " MPa", 1) + _at(dyn, "hertz_stress_max"),
+        ),
         ("follower jump", _fmt(dyn.get("jump"))),
         (
             "fit control points",
