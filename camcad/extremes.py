@@ -26,10 +26,10 @@ from typing import Literal
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray
+from camcad.angles import TWO_PI
 
 __all__ = ["SIDE_WORDS", "Extreme", "Kind", "Quantity", "Side", "extremes", "maximum", "minimum", "side_text"]
 
-TWO_PI = 2.0 * math.pi
 Side = Literal["left", "right"]
 """Which one-sided limit at a joint: ``"left"`` (just before it), ``"right"`` (just after)."""
 

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
+from camcad.angles import TWO_PI
 from camcad.design import DynamicsModel, DynamicsSpec, FollowerKind, Rotation
 from camcad.dynamics.contact import contact_curvature, effective_modulus, hertz_stress
 from camcad.dynamics.energy import FollowerLoad, contact_force, input_torque
@@ -33,7 +34,6 @@ if TYPE_CHECKING:
 __all__ = ["analyse_dynamics"]
 
 _RAD_S_TO_RPM = 60.0 / (2.0 * math.pi)
-TWO_PI = 2.0 * math.pi
 # Warn when a guide force changes side and its misdirected friction exceeds this share of N1.
 _GUIDE_FLIP_RTOL = 0.01
 

@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from camcad._typing import FloatArray, readonly
+from camcad.angles import TWO_PI
 from camcad.errors import FitError
 from camcad.fit._limits import Names, limit_error
 from camcad.fit.bspline import (
@@ -69,7 +70,6 @@ from camcad.fit.seam import longest_stretch, seam_parameter
 
 __all__ = ["ProfileFit", "fit_points", "fit_profile"]
 
-TWO_PI = 2.0 * np.pi
 REPLACEMENTS = 2  # knot placements per count (equidistribution passes); more did not pay
 WINDOW = 3  # smaller counts that must all fail before a count is accepted
 START_SPANS = 16  # spans of the first count tried (then the h^{p+1} law)

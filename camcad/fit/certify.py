@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from camcad._typing import FloatArray, readonly
+from camcad.angles import TWO_PI
 from camcad.fit.bspline import curve_derivatives
 from camcad.fit.curve import BSplineCurve
 
@@ -40,7 +41,6 @@ __all__ = [
     "seam_jumps",
 ]
 
-TWO_PI = 2.0 * np.pi
 CERT_REL_TOL = 1e-3  # the bound is within this fraction of the best distance found
 CERT_NODES_PER_SPAN = 8  # starting nodes per knot span of the curve
 CERT_GRID_STEP = np.pi / 180.0  # rad, starting nodes at least this dense
