@@ -229,7 +229,8 @@ def _signed(curve: BSplineCurve, points: FloatArray, foot: FloatArray) -> FloatA
     c, d1 = curve_derivatives(curve, foot, 1)
     r = points - c
     side = d1[:, 0] * r[:, 1] - d1[:, 1] * r[:, 0]
-    return np.where(side < 0.0, -1.0, 1.0) * np.hypot(r[:, 0], r[:, 1])
+    signed: FloatArray = np.where(side < 0.0, -1.0, 1.0) * np.hypot(r[:, 0], r[:, 1])
+    return signed
 
 
 def _interval_bounds(
@@ -384,7 +385,9 @@ def certify_exact(
 
 def _curvature(d1: FloatArray, d2: FloatArray) -> FloatArray:
     """Signed curvature κ = (x'y'' − y'x'') / |C'|³ [1/mm]."""
-    return (d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]) / np.hypot(d1[..., 0], d1[..., 1]) ** 3
+    cross = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
+    kappa: FloatArray = cross / np.hypot(d1[..., 0], d1[..., 1]) ** 3
+    return kappa
 
 
 def seam_jumps(clamped: BSplineCurve) -> tuple[float, float]:

@@ -65,10 +65,12 @@ class Guide:
     def driven(self, point: FloatArray) -> FloatArray:
         """(n, 2) unit direction in which the follower drives the machine-frame points (n, 2)."""
         if self.axis is not None:
-            return np.broadcast_to(np.asarray(self.axis, dtype=float), point.shape).copy()
+            along: FloatArray = np.broadcast_to(np.asarray(self.axis, dtype=np.float64), point.shape).copy()
+            return along
         assert self.pivot is not None
         arm = point - np.asarray(self.pivot, dtype=float)
-        return self.turn * _quarter(arm) / np.hypot(arm[:, 0], arm[:, 1])[:, None]
+        unit: FloatArray = self.turn * _quarter(arm) / np.hypot(arm[:, 0], arm[:, 1])[:, None]
+        return unit
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -224,6 +226,6 @@ def pressure_angle(
     d_perp = np.column_stack((d[:, 1], -d[:, 0]))
     along = np.einsum("ij,ij->i", normal, d)
     across = np.einsum("ij,ij->i", normal, d_perp)
-    out = np.arctan2(-sigma * across, along)
+    out: FloatArray = np.arctan2(-sigma * across, along)
     readonly(out)
     return out
