@@ -89,7 +89,20 @@ class Extreme:
         return 360.0 if self.side == "left" and self.phi >= TWO_PI else round(deg % 360.0, 9)
 
     def where(self) -> str:
-        """``"at 90.0°"`` or ``"at 90.0° (just before the joint)"``."""
+        """``"at 90.0°"`` or ``"at 90.0° (just before the joint)"``.
+
+        Examples
+        --------
+        >>> Extreme(value=1.0, phi=math.pi / 2).where()
+        'at 90.0°'
+        >>> Extreme(value=-0.5, phi=math.pi / 2, side="left").where()
+        'at 90.0° (just before the joint)'
+
+        The limit just before the joint at 0° is reported at 360°:
+
+        >>> Extreme(value=2.0, phi=TWO_PI, side="left").where()
+        'at 360.0° (just before the joint)'
+        """
         return f"at {self.angle_deg:.1f}°{side_text(self.side)}"
 
 

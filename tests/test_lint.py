@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib.util
 import subprocess
 import sys
+from typing import Any
 
 import pytest
 
@@ -47,12 +48,25 @@ def test_mypy_strict_is_clean_on_the_typed_core():
     assert proc.returncode == 0, proc.stdout + proc.stderr
 
 
-def test_mypy_config_checks_the_same_set_strictly():
-    """``python -m mypy`` alone reads [tool.mypy] in pyproject.toml: the same modules, strict."""
+def _tool_config(name: str) -> dict[str, Any]:
     if sys.version_info >= (3, 11):
         import tomllib
     else:  # pragma: no cover - Python 3.10
         import tomli as tomllib
-    config = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["mypy"]
+    tools: dict[str, Any] = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]
+    config: dict[str, Any] = tools[name]
+    return config
+
+
+def test_mypy_config_checks_the_same_set_strictly():
+    """``python -m mypy`` alone reads [tool.mypy] in pyproject.toml: the same modules, strict."""
+    config = _tool_config("mypy")
     assert config["strict"] is True
     assert sorted(config["files"]) == sorted(STRICT_TYPED)
+
+
+def test_doctests_run_in_the_suite():
+    """A plain ``python -m pytest`` collects the docstrings' examples in camcad/ as tests."""
+    config = _tool_config("pytest")["ini_options"]
+    assert "--doctest-modules" in config["addopts"].split()
+    assert "camcad" in config["testpaths"]
