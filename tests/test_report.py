@@ -1,5 +1,6 @@
 import base64
 import math
+import re
 import subprocess
 import sys
 from dataclasses import replace
@@ -212,24 +213,34 @@ def test_render_compare_needs_a_design():
         render_compare([])
 
 
-class _Toolpath:
-    """Stands in for the planned toolpath: only its summary is rendered."""
+def _count_blocks_and_arcs(text: str) -> tuple[int, int]:
+    """Blocks (lines with a word outside comments) and arc moves (G2/G3 modal) of a G-code text."""
+    blocks = arcs = 0
+    mode = None
+    for line in text.splitlines():
+        words = re.findall(r"([A-Z])\s*([-+]?[0-9.]+)", re.sub(r"\(.*?\)|;.*", "", line).upper())
+        if not words:
+            continue
+        blocks += 1
+        for letter, number in words:
+            if letter == "G" and float(number) in (0.0, 1.0, 2.0, 3.0):
+                mode = int(float(number))
+        if mode in (2, 3) and any(letter in "XYZ" for letter, _ in words):
+            arcs += 1
+    return blocks, arcs
 
-    def summary(self):
-        return {
-            "blocks": 1234,
-            "arcs": 56,
-            "cutting_length_mm": 812.5,
-            "max_deviation_mm": 0.004,
-            "passes": [{"z_mm": -3.0, "kind": "rough"}, {"z_mm": -6.0, "kind": "<finish>"}],
-            "tool": {"diameter_mm": 10.0, "number": 1},
-        }
 
+def test_report_renders_the_planned_toolpath(analysis):
+    """The G-code table shows the real plan's figures: blocks and arcs counted here from the program text."""
+    from camcad.export.gcode import render_gcode
 
-def test_report_renders_gcode_section(analysis):
-    page = render_report(replace(analysis, toolpath=_Toolpath()))
-    parsed = parse(page)
+    planned = analyse(analysis.design, fit=False, toolpath=True).toolpath
+    blocks, arcs = _count_blocks_and_arcs(render_gcode(planned))
+    assert blocks > 100 and arcs > 50  # a real program, not an empty one
+    page = render_report(replace(analysis, toolpath=planned))
     assert 'id="table-gcode"' in page
-    assert "<finish>" not in page and "<finish>" in parsed.plain
-    for key in ("blocks", "1234", "cutting_length_mm", "812.5", "max_deviation_mm", "diameter_mm"):
-        assert key in parsed.plain
+    plain = parse(page).plain
+    section = plain[plain.index("G-code") :]
+    assert f"blocks {blocks} " in section and f"arcs {arcs} " in section
+    for key in ("cutting_length_mm", "cycle_time_s", "max_deviation_mm"):
+        assert key in section
