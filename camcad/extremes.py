@@ -50,6 +50,9 @@ _CONTINUOUS_RTOL = 1e-9  # one-sided limits this close are one value: no "just b
 _ITERATIONS = 60  # at most; a golden step alone shrinks a bracket by 0.618 (0.618^60 ≈ 3e-13)
 _XTOL = 1e-11  # rad: the smallest step the search takes
 _XSTOP = 1e-9  # rad: a parabolic step this small has converged (the value's error is ~q″·1e-18)
+# Where a piece's first and last sample gaps are probed, as fractions of the gap (see _end_brackets):
+# next to both ends, which catches a peak right beside a joint, and at eighths.
+_END_PROBES = np.array([1e-3, *(np.arange(1, 8) / 8), 1.0 - 1e-3])
 
 
 def side_text(side: Side | None) -> str:
@@ -158,6 +161,43 @@ def _brackets(seq: _Sequence, sign: float) -> tuple[FloatArray, FloatArray, Floa
     return seq.phi[idx - 1], seq.phi[idx], seq.phi[idx + 1], val[idx]
 
 
+def _end_brackets(
+    quantity: Quantity, seq: _Sequence, sign: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Brackets of maxima of sign·value hidden in a piece's first or last sample gap.
+
+    Where a piece's end (a one-sided limit or the right value at a joint) is
+    at least its neighbouring sample, the quantity may still rise from the end
+    and fall back below it before that sample, so no sample shows the
+    maximum. Each such gap is probed at ``_END_PROBES``: where a probe beats
+    both ends, it and its neighbours bracket the maximum. The probes beside
+    the ends see the slope there: a quantity that rises from the end into the
+    gap beats the end a thousandth of the gap inside.
+    """
+    val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
+    same_prev = np.zeros(val.size, bool)
+    same_prev[1:] = seq.piece[1:] == seq.piece[:-1]
+    same_next = np.zeros(val.size, bool)
+    same_next[:-1] = seq.piece[:-1] == seq.piece[1:]
+    finite = np.isfinite(val)
+    first = np.flatnonzero(~same_prev & same_next & finite & (val >= np.roll(val, -1)))
+    last = np.flatnonzero(same_prev & ~same_next & finite & (val >= np.roll(val, 1)))
+    lo_i, hi_i = np.concatenate((first, last - 1)), np.concatenate((first + 1, last))
+    if lo_i.size == 0:
+        empty = np.zeros(0)
+        return empty, empty, empty, empty
+    a, b = seq.phi[lo_i], seq.phi[hi_i]
+    inner = a[:, None] + (b - a)[:, None] * _END_PROBES
+    f_inner = sign * np.asarray(quantity(inner.ravel(), "right"), dtype=float).reshape(inner.shape)
+    pts = np.column_stack((a, inner, b))
+    f_inner = np.where(np.isfinite(f_inner), f_inner, -np.inf)  # as _brackets: finite peaks only
+    fs = np.column_stack((val[lo_i], f_inner, val[hi_i]))
+    j = np.argmax(fs, axis=1)
+    rows = np.flatnonzero((j > 0) & (j < pts.shape[1] - 1))
+    j = j[rows]
+    return pts[rows, j - 1], pts[rows, j], pts[rows, j + 1], fs[rows, j]
+
+
 def _refine_max(
     quantity: Quantity, x1: FloatArray, x2: FloatArray, x3: FloatArray, f2: FloatArray, sign: float
 ) -> tuple[FloatArray, FloatArray]:
@@ -262,7 +302,8 @@ def extremes(
         val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
         k = int(np.argmax(val))
         best = Extreme(value=float(seq.value[k]), phi=float(seq.phi[k]), side=_sample_side(seq, k))
-        lo, mid, hi, f_mid = _brackets(seq, sign)
+        inside, at_ends = _brackets(seq, sign), _end_brackets(quantity, seq, sign)
+        lo, mid, hi, f_mid = (np.concatenate(pair) for pair in zip(inside, at_ends, strict=True))
         if lo.size:
             phi, f = _refine_max(quantity, lo, mid, hi, f_mid, sign)
             i = int(np.argmax(f))
