@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from camcad.design import load_design
-from camcad.pipeline import analyse
+from camcad.pipeline import analyse, build
 from camcad.report import compare_table, render_compare, render_report, write_compare, write_report
 
 SAMPLES = Path(__file__).resolve().parents[1] / "samples"
@@ -230,14 +230,12 @@ def _count_blocks_and_arcs(text: str) -> tuple[int, int]:
     return blocks, arcs
 
 
-def test_report_renders_the_planned_toolpath(analysis):
-    """The G-code table shows the real plan's figures: blocks and arcs counted here from the program text."""
-    from camcad.export.gcode import render_gcode
-
-    planned = analyse(analysis.design, fit=False, toolpath=True).toolpath
-    blocks, arcs = _count_blocks_and_arcs(render_gcode(planned))
+def test_report_shows_the_programs_figures(analysis, tmp_path):
+    """The G-code table of a built report: blocks and arcs as counted here in the cam.ngc beside it."""
+    build(analysis.design, tmp_path, only=["gcode", "report"])
+    blocks, arcs = _count_blocks_and_arcs((tmp_path / "cam.ngc").read_text(encoding="utf-8"))
     assert blocks > 100 and arcs > 50  # a real program, not an empty one
-    page = render_report(replace(analysis, toolpath=planned))
+    page = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert 'id="table-gcode"' in page
     plain = parse(page).plain
     section = plain[plain.index("G-code") :]
