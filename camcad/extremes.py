@@ -26,6 +26,7 @@ from typing import Literal
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray
+from camcad.angles import TWO_PI
 
 __all__ = [
     "SIDE_WORDS",
@@ -41,7 +42,6 @@ __all__ = [
     "side_text",
 ]
 
-TWO_PI = 2.0 * math.pi
 Side = Literal["left", "right"]
 """Which one-sided limit at a joint: ``"left"`` (just before it), ``"right"`` (just after)."""
 
@@ -60,12 +60,14 @@ Quantity = Callable[[FloatArray, Side], FloatArray]
 SIDE_WORDS = {"left": "before joint", "right": "after joint"}
 """How summary.json names a one-sided limit (the ``*_side`` keys)."""
 
-_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0  # 0.618
 _GOLDEN_SECTION = (3.0 - math.sqrt(5.0)) / 2.0  # 0.382: the golden step into the larger side
 _CONTINUOUS_RTOL = 1e-9  # one-sided limits this close are one value: no "just before the joint"
 _ITERATIONS = 60  # at most; a golden step alone shrinks a bracket by 0.618 (0.618^60 ≈ 3e-13)
 _XTOL = 1e-11  # rad: the smallest step the search takes
 _XSTOP = 1e-9  # rad: a parabolic step this small has converged (the value's error is ~q″·1e-18)
+# Where a piece's first and last sample gaps are probed, as fractions of the gap (see _end_brackets):
+# next to both ends, which catches a peak right beside a joint, and at eighths.
+_END_PROBES = np.array([1e-3, *(np.arange(1, 8) / 8), 1.0 - 1e-3])
 
 
 def side_text(side: Side | None) -> str:
@@ -105,7 +107,20 @@ class Extreme:
         return 360.0 if self.side == "left" and self.phi >= TWO_PI else round(deg % 360.0, 9)
 
     def where(self) -> str:
-        """``"at 90.0°"`` or ``"at 90.0° (just before the joint)"``."""
+        """``"at 90.0°"`` or ``"at 90.0° (just before the joint)"``.
+
+        Examples
+        --------
+        >>> Extreme(value=1.0, phi=math.pi / 2).where()
+        'at 90.0°'
+        >>> Extreme(value=-0.5, phi=math.pi / 2, side="left").where()
+        'at 90.0° (just before the joint)'
+
+        The limit just before the joint at 0° is reported at 360°:
+
+        >>> Extreme(value=2.0, phi=TWO_PI, side="left").where()
+        'at 360.0° (just before the joint)'
+        """
         return f"at {self.angle_deg:.1f}°{side_text(self.side)}"
 
 
@@ -203,7 +218,7 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
         out_rows.append(r)
         x1.append(lo)
         x3.append(hi)
-        x2.append(lo + _GOLDEN * (hi - lo) if nb_step < 0 else hi - _GOLDEN * (hi - lo))
+        x2.append(np.full(r.size, np.nan))  # to be probed (see _probe_end_gaps)
         f_end, f_nb = val[r, i], val[r, j]
         f1.append(f_nb if nb_step < 0 else f_end)
         f3.append(f_end if nb_step < 0 else f_nb)
@@ -218,8 +233,41 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
     )
 
 
+def _probe_end_gaps(f: _Picker, b: _Brackets) -> _Brackets:
+    """Bracket the maxima hidden in the first or last sample gap of a piece, or drop the gap.
+
+    Where a piece's end (a one-sided limit or the right value at a joint) is
+    at least its neighbouring sample, the quantity may still rise from the end
+    and fall back below it before that sample, so no sample shows the maximum
+    (hypothesis found one: a contact force peaking 0.045° after a joint of a
+    modified trapezoid). Each such gap (x2 unknown) is probed at
+    ``_END_PROBES``, all in one call: where a probe beats both ends, it and
+    its neighbours bracket the maximum; the probes a thousandth of the gap
+    from the ends see a quantity that rises out of the end. Other gaps are
+    dropped: the end's own value is already a candidate.
+    """
+    gap = np.flatnonzero(np.isnan(b.x2))
+    if gap.size == 0:
+        return b
+    lo, hi = b.x1[gap], b.x3[gap]
+    probes = lo[:, None] + (hi - lo)[:, None] * _END_PROBES
+    f_probes = f(probes.ravel(), np.repeat(gap, _END_PROBES.size)).reshape(probes.shape)
+    pts = np.column_stack((lo, probes, hi))
+    fs = np.column_stack((b.f1[gap], f_probes, b.f3[gap]))
+    j = np.argmax(fs, axis=1)
+    hit = (j > 0) & (j < pts.shape[1] - 1)
+    keep = np.ones(b.x1.size, bool)
+    keep[gap[~hit]] = False
+    g, jj, k = gap[hit], j[hit], np.flatnonzero(hit)
+    x1, x2, x3 = b.x1.copy(), b.x2.copy(), b.x3.copy()
+    f1, f2, f3 = b.f1.copy(), b.f2.copy(), b.f3.copy()
+    x1[g], x2[g], x3[g] = pts[k, jj - 1], pts[k, jj], pts[k, jj + 1]
+    f1[g], f2[g], f3[g] = fs[k, jj - 1], fs[k, jj], fs[k, jj + 1]
+    return _Brackets(b.row[keep], x1[keep], x2[keep], x3[keep], f1[keep], f2[keep], f3[keep])
+
+
 def _refine_max(f: _Picker, b: _Brackets) -> tuple[FloatArray, FloatArray]:
-    """Maximise f on every bracket x1 < x2 < x3 (f(x2) nan: not yet known); vectorised.
+    """Maximise f on every bracket x1 < x2 < x3 with f known at all three; vectorised.
 
     Safeguarded successive parabolic interpolation (Brent 1973, ch. 5): each
     step evaluates the vertex of the parabola through the three best points,
@@ -231,9 +279,6 @@ def _refine_max(f: _Picker, b: _Brackets) -> tuple[FloatArray, FloatArray]:
     """
     a, b_, x = b.x1.copy(), b.x3.copy(), b.x2.copy()
     fx = b.f2.copy()
-    unknown = np.isnan(fx)
-    if unknown.any():
-        fx[unknown] = f(x[unknown], np.flatnonzero(unknown))
     w, fw = b.x1.copy(), b.f1.copy()
     v, fv = b.x3.copy(), b.f3.copy()
     # the best of the three seeds the search
@@ -327,6 +372,8 @@ def extremes_rows(
         for r in range(k)
     ]
     br = _brackets(seq, val, best)
+    picker = _Picker(quantity, sign[:, 0], br.row, k)
+    br = _probe_end_gaps(picker, br)
     if br.x1.size:
         phi_best, f_best = _refine_max(_Picker(quantity, sign[:, 0], br.row, k), br)
         for r in range(k):

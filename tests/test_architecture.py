@@ -1,63 +1,251 @@
-"""Data flows one way: a module imports camcad code only from its own layer or below.
+"""Data flows one way, and no camcad module depends on itself through others.
 
-The layers are those of the README's architecture section; imports under
-``if TYPE_CHECKING:`` are type hints only and are not counted.
+The layers are those of the README's architecture section, bottom first::
+
+    shared bottom (_typing, _version, errors, angles, extremes, findings, units)
+      < motion < geometry < dynamics < fit < toolpath < export
+      < design
+      < analysis, report, _plots < pipeline < cli, __init__, __main__
+
+A module imports camcad code only from its own layer or below. The design
+schema (``camcad/design.py``, later ``design/``) sits above the stages: only
+``analysis``, ``report``, ``_plots``, ``pipeline`` and ``cli`` (and ``design``
+itself) may import it; the stages that still do are listed, each with its
+reason, in ``KNOWN_DESIGN_IMPORTS``, which may only shrink.
+
+Imports are read with :mod:`ast` (nothing is imported). Those under
+``if TYPE_CHECKING:`` are type hints only and are not counted; imports inside
+functions run, so they are.
 """
 
 from __future__ import annotations
 
 import ast
+import functools
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 from tests.conftest import ROOT
 
-LAYERS = {
-    "_typing": 0, "_version": 0, "errors": 0, "angles": 0, "extremes": 0, "findings": 0,
-    "motion": 1,
-    "geometry": 2,
-    "dynamics": 3, "fit": 3,
-    "export": 4,
-    "design": 5,  # the schema sits above the stages: each stage owns its options
-    "analysis": 5,
-    "report": 6, "_plots": 6,
-    "pipeline": 7,
-    "cli": 8, "__init__": 8, "__main__": 8,
-}  # fmt: skip
+PACKAGE = ROOT / "camcad"
+
+# Layer of each top-level name under camcad/ (a module or a package), bottom first.
+LAYER_ORDER: tuple[frozenset[str], ...] = (
+    frozenset({"_typing", "_version", "errors", "angles", "extremes", "findings", "units"}),
+    frozenset({"motion"}),
+    frozenset({"geometry"}),
+    frozenset({"dynamics"}),
+    frozenset({"fit"}),
+    frozenset({"toolpath"}),  # camcad/toolpath/ (issue 13): the arc-spline tool paths
+    frozenset({"export"}),
+    frozenset({"design"}),  # the schema sits above every stage
+    frozenset({"analysis", "report", "_plots"}),
+    frozenset({"pipeline"}),
+    frozenset({"cli", "__init__", "__main__"}),
+)
+LAYERS: dict[str, int] = {name: rank for rank, names in enumerate(LAYER_ORDER) for name in names}
+DESIGN_READERS_FROM = LAYERS["analysis"]  # this layer and those above may import design
+
+_UNTIL_SPLIT = "until GcodeSpec, Dialect and Direction move into toolpath/ with the planner (issue 13)"
+# Stage modules that import camcad.design today. The list only shrinks: a module that
+# stops importing design must leave it, and a module not in it may not start.
+KNOWN_DESIGN_IMPORTS: dict[str, str] = {
+    "camcad.export.gcode._passes": _UNTIL_SPLIT + " (GcodeSpec options)",
+    "camcad.export.gcode.dialects": _UNTIL_SPLIT + " (Dialect)",
+    "camcad.export.gcode.toolpath": _UNTIL_SPLIT + " (Direction, GcodeSpec)",
+    "camcad.export.gcode.verify": _UNTIL_SPLIT + " (GcodeSpec)",
+    "camcad.export.gcode.writer": _UNTIL_SPLIT + " (Dialect, GcodeSpec)",
+}
+
+# Import cycles that exist today, each as the sorted tuple of its modules. The list
+# only shrinks: a new cycle fails, and so does an entry whose cycle is gone.
+KNOWN_CYCLES: dict[tuple[str, ...], str] = {
+    ("camcad.export.gcode.toolpath", "camcad.export.gcode.writer"): (
+        "plan_toolpath calls render_gcode and render_gcode calls plan_toolpath, both through "
+        "imports deferred into the function; the toolpath/ package (issue 13) separates planning "
+        "from writing"
+    ),
+}
 
 
-def _runtime_imports(tree: ast.Module) -> list[str]:
-    """Modules imported outside ``if TYPE_CHECKING:`` blocks."""
+def _module_name(path: Path) -> str:
+    """``camcad/fit/curve.py`` -> ``camcad.fit.curve``; a package is named by its folder."""
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+@functools.cache
+def _sources() -> dict[str, tuple[Path, ast.Module]]:
+    """Every camcad module: its name -> (path, parsed source)."""
+    paths = sorted(PACKAGE.rglob("*.py"))
+    return {_module_name(p): (p, ast.parse(p.read_text(encoding="utf-8"))) for p in paths}
+
+
+def runtime_imports(tree: ast.Module, *, module: str, is_package: bool, known: Iterable[str]) -> set[str]:
+    """The camcad modules ``module`` imports when it runs (``if TYPE_CHECKING:`` excluded).
+
+    ``from camcad.fit import curve`` names the module ``camcad.fit.curve`` when it
+    is one of ``known``, else (a name defined in the package) ``camcad.fit``.
+    Relative imports are resolved against ``module``.
+    """
+    known = set(known)
     skip: set[int] = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
             skip |= {id(n) for child in node.body for n in ast.walk(child)}
-    out = []
+    package = module if is_package else module.rpartition(".")[0]
+    out: set[str] = set()
     for node in ast.walk(tree):
         if id(node) in skip:
             continue
-        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            out.append(node.module)
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                source = ".".join([*base, node.module] if node.module else base)
+            else:
+                source = node.module or ""
+            for alias in node.names:
+                if f"{source}.{alias.name}" in known:
+                    out.add(f"{source}.{alias.name}")
+                elif source == "camcad" or source.startswith("camcad."):
+                    out.add(source)
         elif isinstance(node, ast.Import):
-            out += [a.name for a in node.names]
-    return [m for m in out if m == "camcad" or m.startswith("camcad.")]
+            out |= {a.name for a in node.names if a.name == "camcad" or a.name.startswith("camcad.")}
+    out.discard(module)
+    return out
 
 
-# Until the G-code planner moves into toolpath/ with its options (issue 13), it reads GcodeSpec,
-# Dialect and Direction from the design package.
-KNOWN_DESIGN_IMPORTS = {"export/gcode"}
+@functools.cache
+def import_graph() -> dict[str, frozenset[str]]:
+    """Runtime import graph of every camcad module."""
+    sources = _sources()
+    return {
+        name: frozenset(
+            runtime_imports(tree, module=name, is_package=path.name == "__init__.py", known=sources)
+        )
+        for name, (path, tree) in sources.items()
+    }
 
 
-def _known(path: Path, module: str) -> bool:
-    return module == "camcad.design" and any(k in path.as_posix() for k in KNOWN_DESIGN_IMPORTS)
+def top_name(module: str) -> str:
+    """The top-level name that places a module in a layer (``__init__`` for ``camcad``)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "__init__"
+
+
+def layer_violations(graph: Mapping[str, Iterable[str]]) -> tuple[list[str], set[str]]:
+    """Upward imports, and the modules below the design readers that import design."""
+    upward: list[str] = []
+    design_importers: set[str] = set()
+    for module, targets in sorted(graph.items()):
+        mine = top_name(module)
+        assert mine in LAYERS, f"{module} is in no layer: add {mine!r} to LAYER_ORDER and the README"
+        for target in sorted(targets):
+            theirs = top_name(target)
+            assert theirs in LAYERS, f"{target} is in no layer: add {theirs!r} to LAYER_ORDER and the README"
+            if theirs == "design":
+                if mine != "design" and LAYERS[mine] < DESIGN_READERS_FROM:
+                    design_importers.add(module)
+            elif LAYERS[theirs] > LAYERS[mine]:
+                upward.append(f"{module} (layer {mine}) imports {target} (layer {theirs})")
+    return upward, design_importers
+
+
+def find_cycles(graph: Mapping[str, Iterable[str]]) -> set[tuple[str, ...]]:
+    """Every import cycle a depth-first search meets, each as the sorted tuple of its modules.
+
+    Each back edge u -> v of the DFS closes one cycle: the stack from v up to u.
+    """
+    edges = {u: sorted(vs) for u, vs in graph.items()}
+    state: dict[str, int] = {}  # 1 on the stack, 2 done
+    stack: list[str] = []
+    cycles: set[tuple[str, ...]] = set()
+
+    def visit(u: str) -> None:
+        state[u] = 1
+        stack.append(u)
+        for v in edges.get(u, ()):
+            if state.get(v) == 1:
+                cycles.add(tuple(sorted(stack[stack.index(v) :])))
+            elif v not in state:
+                visit(v)
+        stack.pop()
+        state[u] = 2
+
+    for u in sorted(edges):
+        if u not in state:
+            visit(u)
+    return cycles
 
 
 def test_no_module_imports_a_higher_layer():
-    upward = []
-    for path in sorted((ROOT / "camcad").rglob("*.py")):
-        mine = path.relative_to(ROOT / "camcad").with_suffix("").parts[0]
-        for module in _runtime_imports(ast.parse(path.read_text())):
-            target = module.split(".")[1] if "." in module else "__init__"
-            assert target in LAYERS, f"{module} is in no layer: add it to LAYERS and the README"
-            if LAYERS[target] > LAYERS[mine] and not _known(path, module):
-                upward.append(f"{Path(path).relative_to(ROOT)} imports {module}")
-    assert not upward, upward
+    upward, _ = layer_violations(import_graph())
+    assert not upward, "\n".join(upward)
+
+
+def test_only_the_known_stage_modules_import_design():
+    _, importers = layer_violations(import_graph())
+    new = sorted(importers - KNOWN_DESIGN_IMPORTS.keys())
+    assert not new, f"stage modules must not import camcad.design (take per-stage options instead): {new}"
+    gone = sorted(KNOWN_DESIGN_IMPORTS.keys() - importers)
+    assert not gone, f"no longer import camcad.design: remove them from KNOWN_DESIGN_IMPORTS: {gone}"
+
+
+def test_no_new_import_cycle():
+    cycles = find_cycles(import_graph())
+    new = sorted(cycles - KNOWN_CYCLES.keys())
+    assert not new, f"import cycles among camcad modules: {new}"
+    gone = sorted(KNOWN_CYCLES.keys() - cycles)
+    assert not gone, f"these cycles are gone: remove them from KNOWN_CYCLES: {gone}"
+
+
+# The checks themselves, on made-up modules: they must be able to fail.
+
+
+def _imports_of(source: str, module: str = "camcad.motion.laws", known: Iterable[str] = ()) -> set[str]:
+    return runtime_imports(ast.parse(source), module=module, is_package=False, known=known)
+
+
+def test_reader_counts_runtime_imports_only():
+    source = (
+        "from typing import TYPE_CHECKING\n"
+        "import numpy\n"
+        "from camcad.errors import SpecError\n"
+        "from . import _lawbase\n"
+        "from ..geometry import cam\n"
+        "if TYPE_CHECKING:\n"
+        "    from camcad.fit import ProfileFit\n"
+        "def late():\n"
+        "    import camcad.export.dxf\n"
+    )
+    found = _imports_of(source, known={"camcad.motion._lawbase", "camcad.geometry.cam"})
+    assert found == {"camcad.errors", "camcad.motion._lawbase", "camcad.geometry.cam", "camcad.export.dxf"}
+
+
+def test_layer_check_flags_upward_and_design_imports():
+    graph = {
+        "camcad.motion.laws": {"camcad.fit.curve", "camcad.errors"},
+        "camcad.geometry.cam": {"camcad.design", "camcad.motion.laws"},
+        "camcad.pipeline": {"camcad.design", "camcad.cli"},
+        "camcad.design": {"camcad.motion.laws"},
+    }
+    upward, importers = layer_violations(graph)
+    assert upward == [
+        "camcad.motion.laws (layer motion) imports camcad.fit.curve (layer fit)",
+        "camcad.pipeline (layer pipeline) imports camcad.cli (layer cli)",
+    ]
+    assert importers == {"camcad.geometry.cam"}
+
+
+def test_layer_order_is_the_documented_chain():
+    chain = ["motion", "geometry", "dynamics", "fit", "toolpath", "export", "design", "analysis", "pipeline"]
+    ranks = [LAYERS[name] for name in chain]
+    assert ranks == sorted(set(ranks)), "each stage sits strictly above the one before it"
+    assert LAYERS["report"] == LAYERS["_plots"] == LAYERS["analysis"]
+    assert LAYERS["extremes"] < LAYERS["motion"] and LAYERS["cli"] == max(LAYERS.values())
+
+
+def test_cycle_finder_finds_a_made_up_cycle():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a", "d"}, "d": set(), "e": {"e"}}
+    assert find_cycles(graph) == {("a", "b", "c"), ("e",)}
+    assert find_cycles({"a": {"b"}, "b": {"c"}, "c": set()}) == set()

@@ -1,5 +1,6 @@
 import base64
 import math
+import re
 import subprocess
 import sys
 from dataclasses import replace
@@ -9,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from camcad.design import load_design
-from camcad.pipeline import analyse
+from camcad.pipeline import analyse, build
 from camcad.report import compare_table, render_compare, render_report, write_compare, write_report
 
 SAMPLES = Path(__file__).resolve().parents[1] / "samples"
@@ -213,24 +214,32 @@ def test_render_compare_needs_a_design():
         render_compare([])
 
 
-class _Toolpath:
-    """Stands in for the planned toolpath: only its summary is rendered."""
+def _count_blocks_and_arcs(text: str) -> tuple[int, int]:
+    """Blocks (lines with a word outside comments) and arc moves (G2/G3 modal) of a G-code text."""
+    blocks = arcs = 0
+    mode = None
+    for line in text.splitlines():
+        words = re.findall(r"([A-Z])\s*([-+]?[0-9.]+)", re.sub(r"\(.*?\)|;.*", "", line).upper())
+        if not words:
+            continue
+        blocks += 1
+        for letter, number in words:
+            if letter == "G" and float(number) in (0.0, 1.0, 2.0, 3.0):
+                mode = int(float(number))
+        if mode in (2, 3) and any(letter in "XYZ" for letter, _ in words):
+            arcs += 1
+    return blocks, arcs
 
-    def summary(self):
-        return {
-            "blocks": 1234,
-            "arcs": 56,
-            "cutting_length_mm": 812.5,
-            "max_deviation_mm": 0.004,
-            "passes": [{"z_mm": -3.0, "kind": "rough"}, {"z_mm": -6.0, "kind": "<finish>"}],
-            "tool": {"diameter_mm": 10.0, "number": 1},
-        }
 
-
-def test_report_renders_gcode_section(analysis):
-    page = render_report(replace(analysis, toolpath=_Toolpath()))
-    parsed = parse(page)
+def test_report_shows_the_programs_figures(analysis, tmp_path):
+    """The G-code table of a built report: blocks and arcs as counted here in the cam.ngc beside it."""
+    build(analysis.design, tmp_path, only=["gcode", "report"])
+    blocks, arcs = _count_blocks_and_arcs((tmp_path / "cam.ngc").read_text(encoding="utf-8"))
+    assert blocks > 100 and arcs > 50  # a real program, not an empty one
+    page = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert 'id="table-gcode"' in page
-    assert "<finish>" not in page and "<finish>" in parsed.plain
-    for key in ("blocks", "1234", "cutting_length_mm", "812.5", "max_deviation_mm", "diameter_mm"):
-        assert key in parsed.plain
+    plain = parse(page).plain
+    section = plain[plain.index("G-code") :]
+    assert f"blocks {blocks} " in section and f"arcs {arcs} " in section
+    for key in ("cutting_length_mm", "cycle_time_s", "max_deviation_mm"):
+        assert key in section

@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from camcad._typing import ArrayLike
+from camcad.angles import TWO_PI
 
 __all__ = [
     "covering_arc",
@@ -26,8 +27,6 @@ __all__ = [
     "speed_limits",
     "speed_window",
 ]
-
-TWO_PI = 2.0 * math.pi
 
 
 def min_preload(

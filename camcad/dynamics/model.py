@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
+from camcad.angles import TWO_PI
 from camcad.dynamics.contact import contact_curvature, effective_modulus, hertz_stress
 from camcad.dynamics.energy import FollowerLoad, contact_force, input_torque
 from camcad.dynamics.jump import covering_arc, loss_runs, speed_window
@@ -34,7 +35,6 @@ __all__ = ["analyse_dynamics"]
 _RAD_S_TO_RPM = 60.0 / (2.0 * math.pi)
 # the extremes analyse_dynamics reports, one per row of its quantity
 _KINDS: tuple[Kind, ...] = ("min", "max", "min", "max", "max", "max", "max", "min", "max")
-TWO_PI = 2.0 * math.pi
 # Warn when a guide force changes side and its misdirected friction exceeds this share of N1.
 _GUIDE_FLIP_RTOL = 0.01
 

@@ -40,10 +40,12 @@ import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from camcad._typing import FloatArray, readonly
+from camcad.angles import TWO_PI
 from camcad.errors import FitError
 from camcad.fit._limits import Names, limit_error
 from camcad.fit.bspline import (
@@ -67,9 +69,22 @@ from camcad.fit.knots import (
 from camcad.fit.result import ProfileFit
 from camcad.fit.seam import longest_stretch, seam_parameter
 
-__all__ = ["ProfileFit", "fit_points", "fit_profile"]
+__all__ = ["Breakpoint", "ProfileFit", "fit_points", "fit_profile"]
 
-TWO_PI = 2.0 * np.pi
+
+@runtime_checkable
+class Breakpoint(Protocol):
+    """A motion breakpoint as :func:`fit_profile` reads it (e.g. ``camcad.motion.program.Breakpoint``)."""
+
+    @property
+    def phi(self) -> float:
+        """Cam angle φ_k of the breakpoint [rad]."""
+
+    @property
+    def continuity(self) -> int:
+        """The profile is C^k there."""
+
+
 REPLACEMENTS = 2  # knot placements per count (equidistribution passes); more did not pay
 WINDOW = 3  # smaller counts that must all fail before a count is accepted
 START_SPANS = 16  # spans of the first count tried (then the h^{p+1} law)
@@ -151,7 +166,7 @@ def _corrected(params: FloatArray, fit: SplineFit, points: FloatArray, periodic:
     """
     r = fit.at_params - points
     d1 = fit.tangent_at_params
-    new = params - np.einsum("ij,ij->i", r, d1) / np.einsum("ij,ij->i", d1, d1)  # Hoschek 1988
+    new: FloatArray = params - np.einsum("ij,ij->i", r, d1) / np.einsum("ij,ij->i", d1, d1)  # Hoschek 1988
     if periodic:
         new = np.clip(new, 0.0, np.nextafter(1.0, 0.0))
     else:
@@ -421,7 +436,7 @@ def fit_profile(
     points: FloatArray,
     *,
     exact: Callable[[FloatArray], FloatArray],
-    breakpoints: Sequence[tuple[float, int]] = (),
+    breakpoints: Sequence[tuple[float, int] | Breakpoint] = (),
     tolerance: float = 1e-3,
     max_control_points: int | None = None,
     degree: int = 3,
@@ -504,7 +519,7 @@ def _fit_closed(
     points: FloatArray,
     *,
     exact: Callable[[FloatArray], FloatArray],
-    breakpoints: Sequence[tuple[float, int]],
+    breakpoints: Sequence[tuple[float, int] | Breakpoint],
     tolerance: float,
     max_control_points: int | None,
     degree: int,
@@ -524,11 +539,11 @@ def _fit_closed(
 
     def u_of(angle: float) -> float:  # chord-length parameter of a cam angle, unwrapped
         turns, rest = divmod(angle - ang[0], TWO_PI)
-        return turns + float(np.interp(ang[0] + rest, phi_ext, t_ext))
+        return float(turns) + float(np.interp(ang[0] + rest, phi_ext, t_ext))
 
     pairs = []
     for bp in breakpoints:
-        phi_k, k = (bp.phi, bp.continuity) if hasattr(bp, "phi") else bp  # type: ignore[union-attr]
+        phi_k, k = (bp.phi, bp.continuity) if isinstance(bp, Breakpoint) else bp
         pairs.append((float(phi_k), int(k)))
     breaks = [(u_of(phi_k) % 1.0, k) for phi_k, k in pairs]
     stretch = longest_stretch([phi_k for phi_k, _ in pairs])

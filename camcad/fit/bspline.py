@@ -22,7 +22,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 import scipy.linalg
@@ -83,7 +83,7 @@ def chord_length_params(points: FloatArray, *, closed: bool) -> FloatArray:
         i = int(np.argmin(chords))
         raise ValueError(f"points {i} and {(i + 1) % len(pts)} coincide; remove repeated points")
     cum = np.concatenate(([0.0], np.cumsum(chords)))
-    t = cum[: len(pts)] / cum[-1]  # Quang & Hung 2015, eq. 9
+    t: FloatArray = cum[: len(pts)] / cum[-1]  # Quang & Hung 2015, eq. 9
     readonly(t)
     return t
 
@@ -287,11 +287,11 @@ def _normal_equations(
     if fold is not None:
         col %= fold
     flat = (col[r_idx] * n_cols + col[q_idx]).ravel()
-    upper = np.bincount(flat, gram.ravel(), n_cols * n_cols).reshape(n_cols, n_cols)
+    # np.bincount with weights returns float64; numpy's stubs say intp whatever the weights.
+    upper = cast("FloatArray", np.bincount(flat, gram.ravel(), n_cols * n_cols)).reshape(n_cols, n_cols)
     ntn = upper + upper.T - np.diag(np.diag(upper))  # r = q pairs are on the diagonal once
-    ntd = np.stack(
-        [np.bincount(col.ravel(), rhs[:, d, :].ravel(), n_cols) for d in range(data.shape[1])], axis=1
-    )
+    sums = [np.bincount(col.ravel(), rhs[:, d, :].ravel(), n_cols) for d in range(data.shape[1])]
+    ntd = cast("FloatArray", np.stack(sums, axis=1))  # float64, as ``upper``
     return ntn, ntd
 
 

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from camcad._typing import FloatArray, readonly
+from camcad.angles import TWO_PI
 from camcad.fit.bspline import curve_derivatives
 from camcad.fit.curve import BSplineCurve
 
@@ -40,7 +41,6 @@ __all__ = [
     "seam_jumps",
 ]
 
-TWO_PI = 2.0 * np.pi
 CERT_REL_TOL = 1e-3  # the bound is within this fraction of the best distance found
 CERT_NODES_PER_SPAN = 8  # starting nodes per knot span of the curve
 CERT_GRID_STEP = np.pi / 180.0  # rad, starting nodes at least this dense
@@ -229,7 +229,8 @@ def _signed(curve: BSplineCurve, points: FloatArray, foot: FloatArray) -> FloatA
     c, d1 = curve_derivatives(curve, foot, 1)
     r = points - c
     side = d1[:, 0] * r[:, 1] - d1[:, 1] * r[:, 0]
-    return np.where(side < 0.0, -1.0, 1.0) * np.hypot(r[:, 0], r[:, 1])
+    signed: FloatArray = np.where(side < 0.0, -1.0, 1.0) * np.hypot(r[:, 0], r[:, 1])
+    return signed
 
 
 def _interval_bounds(
@@ -384,7 +385,9 @@ def certify_exact(
 
 def _curvature(d1: FloatArray, d2: FloatArray) -> FloatArray:
     """Signed curvature κ = (x'y'' − y'x'') / |C'|³ [1/mm]."""
-    return (d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]) / np.hypot(d1[..., 0], d1[..., 1]) ** 3
+    cross = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
+    kappa: FloatArray = cross / np.hypot(d1[..., 0], d1[..., 1]) ** 3
+    return kappa
 
 
 def seam_jumps(clamped: BSplineCurve) -> tuple[float, float]:

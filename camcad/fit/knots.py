@@ -254,7 +254,8 @@ def _graded(log_values: FloatArray, log_ratio: float, periodic: bool) -> FloatAr
     j = np.arange(len(x)) * log_ratio
     x = np.maximum.accumulate(x + j) - j
     x = (np.maximum.accumulate((x - j)[::-1]) + j[::-1])[::-1]
-    return x[n : 2 * n] if periodic else x
+    graded: FloatArray = x[n : 2 * n] if periodic else x
+    return graded
 
 
 def _error_density(edges: FloatArray, params: FloatArray, errors: FloatArray, degree: int) -> FloatArray:
@@ -366,4 +367,5 @@ def estimate_free_knots(n_free: int, n_segments: int, error: float, tolerance: f
     """
     spans = n_free + n_segments
     ratio = min(max(error / tolerance, 1e-12), 1e12)
-    return max(math.ceil(spans * ratio ** (1.0 / (degree + 1))) - n_segments, 0)
+    growth: float = ratio ** (1.0 / (degree + 1))
+    return max(math.ceil(spans * growth) - n_segments, 0)

@@ -31,11 +31,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from camcad.angles import TWO_PI
 from camcad.fit.curve import BSplineCurve
 
 __all__ = ["longest_stretch", "seam_parameter"]
-
-TWO_PI = 2.0 * np.pi
 
 
 def longest_stretch(breakpoint_phi: Sequence[float]) -> tuple[float, float] | None:

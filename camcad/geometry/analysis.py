@@ -10,7 +10,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from camcad._typing import FloatArray, readonly
-from camcad.angles import flagged_ranges, format_ranges
+from camcad.angles import TWO_PI, flagged_ranges, format_ranges
 from camcad.errors import UndercutError
 from camcad.extremes import SIDE_WORDS, Extreme, Kind, Quantity, Side, extremes_rows
 from camcad.findings import Finding, Severity
@@ -21,7 +21,6 @@ from camcad.geometry.sizing import min_base_radius
 __all__ = ["GeometryAnalysis", "Undercut", "analyse_geometry", "undercut_error"]
 
 _SUGGEST_ROUND_MM = 0.01
-TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -64,14 +64,13 @@ class Guide:
 
     def driven(self, point: FloatArray) -> FloatArray:
         """(n, 2) unit direction in which the follower drives the machine-frame points (n, 2)."""
-        out: FloatArray
         if self.axis is not None:
-            out = np.broadcast_to(np.asarray(self.axis, dtype=float), point.shape).copy()
-            return out
+            along: FloatArray = np.broadcast_to(np.asarray(self.axis, dtype=np.float64), point.shape).copy()
+            return along
         assert self.pivot is not None
         arm = point - np.asarray(self.pivot, dtype=float)
-        out = self.turn * _quarter(arm) / np.hypot(arm[:, 0], arm[:, 1])[:, None]
-        return out
+        unit: FloatArray = self.turn * _quarter(arm) / np.hypot(arm[:, 0], arm[:, 1])[:, None]
+        return unit
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -118,7 +118,7 @@ def _as_x(x: ArrayLike) -> FloatArray:
     return np.asarray(x, dtype=np.float64)
 
 
-def _finish(shape: tuple[int, ...], *arrays: object) -> Derivatives:
+def _finish(shape: tuple[int, ...], *arrays: ArrayLike) -> Derivatives:
     """Copy to fresh float64 arrays of ``shape`` and mark them read-only."""
     y, y1, y2, y3 = (np.array(np.broadcast_to(a, shape), dtype=np.float64) for a in arrays)
     readonly(y, y1, y2, y3)

@@ -30,6 +30,14 @@ class Poly345(Law):
     -----
     y′ = 30x²(1 − x)², y″ = 60x(1 − x)(1 − 2x), y‴ = 60(1 − 6x + 6x²).
     Peak y′ = 15/8; y‴ = 60 at the ends.
+
+    Examples
+    --------
+    At mid-rise x = 1/2: y = 10/8 − 15/16 + 6/32 = 1/2, y′ = 30/16 = 15/8
+    (the peak), y″ = 0 and y‴ = 60(1 − 3 + 3/2) = −30.
+
+    >>> [float(d) for d in Poly345().evaluate(0.5)]
+    [0.5, 1.875, 0.0, -30.0]
     """
 
     name: ClassVar[str] = "poly-345"

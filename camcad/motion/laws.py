@@ -132,6 +132,16 @@ class Cycloidal(Law):
     -----
     y′ = 1 − cos 2πx, y″ = 2π sin 2πx, y‴ = 4π² cos 2πx. Peak y′ = 2, peak
     y″ = 2π. y‴ = 4π² at the ends.
+
+    Examples
+    --------
+    At mid-rise x = 1/2: y = 1/2, y′ = 1 − cos π = 2 (the peak), y″ = 2π sin π
+    = 0 and y‴ = 4π² cos π = −4π².
+
+    >>> import math
+    >>> y, y1, y2, y3 = Cycloidal().evaluate(0.5)
+    >>> float(y), float(y1), float(y2), math.isclose(y3, -4.0 * math.pi**2, rel_tol=1e-15)
+    (0.5, 2.0, 0.0, True)
     """
 
     name: ClassVar[str] = "cycloidal"

@@ -15,10 +15,10 @@ from typing import Literal
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
+from camcad.angles import TWO_PI
 from camcad.motion.segments import SegmentKind, SegmentSpec
 
 __all__ = [
-    "TWO_PI",
     "Breakpoint",
     "Joint",
     "Motion",
@@ -27,7 +27,6 @@ __all__ = [
     "TimeMotion",
 ]
 
-TWO_PI = 2.0 * math.pi
 Side = Literal["left", "right"]
 """Which one-sided limit to take at a joint: ``"left"`` (just before), ``"right"`` (just after)."""
 _SNAP = 1e-12  # a normalised x this close to a law's breakpoint is that breakpoint

@@ -301,5 +301,35 @@ def test_self_locking_tappet_raises():
         tappet_forces(motion, load=load_of(design), omega=design.cam.omega, tappet=tappet_of(design))
 
 
-def test_design_selects_the_model():
-    assert table1_design().dynamics.model is DynamicsModel.GUIDED_TAPPET
+@pytest.mark.parametrize("model", ["guided-tappet", "energy"])
+def test_design_selects_the_model(model):
+    """The model the design names is the one that runs, told apart by forces found independently.
+
+    Guided tappet: N1 of the 3×3 system (eqs. 17, 18, 20) and M = N1 (v + f1 h)
+    (eq. 29). Energy method on a flat face (α = 0): N = F = k (s + y0) + m a ω²
+    + m g, and M = F v. With f = 0.1 the two differ by percents, so each
+    reference rejects the other model.
+    """
+    design = table1_design(model=model)
+    assert design.dynamics.model is DynamicsModel(model)
+    cam = Cam.from_design(design)
+    phi = np.radians(np.arange(0.0, 360.0, 5.0))
+    motion = cam.motion(phi)
+    result = analyse_dynamics(
+        motion,
+        pressure_angle=np.zeros(phi.size),
+        profile_rho=cam.profile(phi).rho,
+        setup=design.dynamics_setup(),
+    )
+    n1 = solve_3x3(motion, design)[:, 0]
+    axial = 31.6 * (motion.s + 10.0) + 0.6 * motion.a * design.cam.omega**2 / 1000 + 0.6 * G
+    references = {
+        "guided-tappet": (n1, n1 * (motion.v + 0.1 * (motion.s + 50.0))),
+        "energy": (axial, axial * motion.v),
+    }
+    force, torque = references[model]
+    assert_allclose(result.contact_force, force, rtol=1e-9)
+    assert (result.normal_force is None) == (model == "energy")
+    assert_allclose(result.torque, torque, rtol=1e-9, atol=1e-9 * np.abs(torque).max())
+    (other_force, _) = references["energy" if model == "guided-tappet" else "guided-tappet"]
+    assert np.max(np.abs(other_force / force - 1.0)) > 0.01
