@@ -16,11 +16,13 @@ import numpy as np
 from camcad._version import __version__
 from camcad.design import Design
 from camcad.dynamics import DynamicsResult
+from camcad.export.gcode.writer import summarize
 from camcad.extremes import SIDE_WORDS, maximum
 from camcad.findings import Finding
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
 from camcad.motion.program import Motion
+from camcad.toolpath import Toolpath
 
 __all__ = ["Analysis", "motion_summary"]
 
@@ -40,7 +42,11 @@ class Analysis:
     fit
         The certified NURBS of the profile, or None when not requested.
     toolpath
-        The planned G-code toolpath, or None when not requested.
+        The planned toolpath, or None when not requested.
+    gcode
+        The toolpath's G-code program in the design's dialect (rendered
+        once: ``cam.ngc`` and the summary's block count both come from it),
+        or None without a toolpath.
     timings
         Seconds per stage.
     stage_findings
@@ -54,7 +60,8 @@ class Analysis:
     geometry: GeometryAnalysis
     dynamics: DynamicsResult
     fit: ProfileFit | None
-    toolpath: Any
+    toolpath: Toolpath | None
+    gcode: str | None = None
     timings: dict[str, float] = field(default_factory=dict)
     stage_findings: tuple[Finding, ...] = ()
 
@@ -85,8 +92,8 @@ class Analysis:
         }
         if self.fit is not None:
             out["fit"] = self.fit.summary()
-        if self.toolpath is not None:
-            out["gcode"] = self.toolpath.summary()
+        if self.toolpath is not None and self.gcode is not None:
+            out["gcode"] = summarize(self.toolpath, self.gcode).as_dict()
         out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]

@@ -16,6 +16,7 @@ LAYERS = {
     "motion": 1, "design": 1,
     "geometry": 2,
     "dynamics": 3, "fit": 3,
+    "toolpath": 3.5,
     "export": 4,
     "analysis": 5,
     "report": 6, "_plots": 6,

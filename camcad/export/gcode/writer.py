@@ -13,13 +13,12 @@ from typing import TYPE_CHECKING, Any
 
 from camcad.design import Dialect, GcodeSpec
 from camcad.export.gcode.dialects import dialect_rules
-from camcad.export.gcode.moves import MoveKind
+from camcad.toolpath.moves import MoveKind
 
 if TYPE_CHECKING:
-    from camcad.export.gcode.toolpath import Toolpath
-    from camcad.geometry.cam import Cam
+    from camcad.toolpath.plan import Toolpath
 
-__all__ = ["GcodeSummary", "count_blocks", "render_gcode", "summarize", "write_gcode"]
+__all__ = ["GcodeSummary", "count_blocks", "render_gcode", "summarize"]
 
 
 def _num(v: float) -> str:
@@ -176,16 +175,3 @@ def summarize(toolpath: Toolpath, text: str) -> GcodeSummary:
         cycle_time_s=time if math.isfinite(time) else 0.0,
         max_deviation_mm=toolpath.max_deviation,
     )
-
-
-def write_gcode(cam: Cam, spec: GcodeSpec, *, name: str, thickness: float, bore: float = 0.0) -> str:
-    """Plan and render in one call: the G-code text (no file is written).
-
-    Raises
-    ------
-    GougeError
-        When the tool is larger than a concave radius of the profile.
-    """
-    from camcad.export.gcode.toolpath import plan_toolpath
-
-    return render_gcode(plan_toolpath(cam, spec, name=name, thickness=thickness, bore=bore))
