@@ -288,8 +288,12 @@ def _levels(
 
 
 def _measure_finish(finish: Sequence[Move], offset: _Projector) -> tuple[float, Direction, float]:
-    """Hausdorff distance [mm] of the finishing contour (leads excluded) to the exact offset curve,
-    its milling direction, and its depth [mm]."""
+    """Hausdorff distance, milling direction and depth of the finishing contour.
+
+    The contour is the finishing pass without its first and last planar
+    moves (the leads); the distance [mm] is two-way, to the exact offset
+    curve; the depth [mm] is its lowest Z.
+    """
     planar = [m for m in finish if _planar(m)]
     contour = planar[1:-1]
     if not contour:
@@ -305,8 +309,12 @@ def _measure_finish(finish: Sequence[Move], offset: _Projector) -> tuple[float, 
 
 
 def _clearance(feed_pts: FloatArray, profile: _Projector, r: float, bore_r: float) -> tuple[float, float]:
-    """Over feed points (n, 3) below the stock top: the smallest clearance from the profile [mm]
-    (distance minus the tool radius ``r``) and the largest reach beyond the bore wall [mm]."""
+    """Smallest clearance from the profile and largest reach beyond the bore wall [mm].
+
+    Over the feed points (n, 3) below the stock top: the clearance is the
+    distance to the exact profile minus the tool radius ``r``; points inside
+    the bore radius ``bore_r`` are measured against the bore wall instead.
+    """
     below = feed_pts[feed_pts[:, 2] < 0.0]
     inside = np.hypot(below[:, 0], below[:, 1]) < bore_r if bore_r > 0 else np.zeros(len(below), bool)
     outer = below[~inside]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from camcad.design import Design, Dialect
-from camcad.errors import DesignError, GcodeSyntaxError
+from camcad.errors import EXIT_INVALID, CamcadError, DesignError, GcodeSyntaxError, exit_code
 from camcad.export.gcode import count_blocks, parse_gcode, render_gcode, summarize
 from camcad.geometry.cam import Cam
 from camcad.toolpath import MoveKind, Toolpath, check_toolpath, plan_toolpath
@@ -138,8 +138,14 @@ def test_parser_reads_units_modes_and_comments():
     ],
 )
 def test_parser_rejects_what_it_cannot_check(text, why):
-    with pytest.raises(GcodeSyntaxError, match=why):
+    with pytest.raises(GcodeSyntaxError, match=why) as err:
         parse_gcode(text)
+    # one line of the hierarchy: bad input (exit 2), still a ValueError, naming the line
+    assert exit_code(err.value) == EXIT_INVALID
+    assert isinstance(err.value, CamcadError) and isinstance(err.value, ValueError)
+    line_no = err.value.line_no
+    assert str(err.value).startswith(f"line {line_no}: ")
+    assert text.splitlines()[line_no - 1].strip() in str(err.value)
 
 
 def test_full_circle_arc_is_one_turn():
