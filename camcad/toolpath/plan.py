@@ -1,7 +1,7 @@
 """Plan the toolpath that mills a cam plate's outside profile (and its bore) from stock.
 
 The tool-centre path is the exact profile offset outward by the tool radius,
-``cam.offset(phi, r_tool)``, approximated by biarcs within the tolerance.
+``cam.offset(phi, r_tool)``, approximated by arc splines within the tolerance.
 Roughing passes step down to the full depth on the path offset by the tool
 radius plus the stock to leave; one full-depth finishing pass follows. Passes
 enter and leave on tangent arcs off the part, may leave holding tabs, and
