@@ -47,7 +47,7 @@ from ezdxf.layouts import Modelspace
 
 from camcad.design import Design, FollowerKind, SegmentKind
 from camcad.errors import ExportError
-from camcad.export._contours import BoreOutline, flatten_bspline, flatten_curve
+from camcad.export._outline import BoreOutline, flatten_bspline, flatten_curve
 from camcad.export.atomic import atomic_write
 from camcad.fit.curve import BSplineCurve
 
