@@ -9,20 +9,22 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from camcad._version import __version__
 from camcad.design import Design
 from camcad.dynamics import DynamicsResult
-from camcad.export.gcode.writer import summarize
 from camcad.extremes import SIDE_WORDS, maximum
 from camcad.findings import Finding
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
 from camcad.motion.program import Motion
-from camcad.toolpath import Toolpath
+
+if TYPE_CHECKING:
+    from camcad.export.gcode import GcodeProgram
+    from camcad.toolpath import Toolpath
 
 __all__ = ["Analysis", "motion_summary"]
 
@@ -44,9 +46,8 @@ class Analysis:
     toolpath
         The planned toolpath, or None when not requested.
     gcode
-        The toolpath's G-code program in the design's dialect (rendered
-        once: ``cam.ngc`` and the summary's block count both come from it),
-        or None without a toolpath.
+        The toolpath rendered once in the design's dialect: the text of
+        ``cam.ngc`` and the summary's figures; None without a toolpath.
     timings
         Seconds per stage.
     stage_findings
@@ -61,7 +62,7 @@ class Analysis:
     dynamics: DynamicsResult
     fit: ProfileFit | None
     toolpath: Toolpath | None
-    gcode: str | None = None
+    gcode: GcodeProgram | None = None
     timings: dict[str, float] = field(default_factory=dict)
     stage_findings: tuple[Finding, ...] = ()
 
@@ -92,8 +93,8 @@ class Analysis:
         }
         if self.fit is not None:
             out["fit"] = self.fit.summary()
-        if self.toolpath is not None and self.gcode is not None:
-            out["gcode"] = summarize(self.toolpath, self.gcode).as_dict()
+        if self.gcode is not None:
+            out["gcode"] = self.gcode.summary()
         out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]

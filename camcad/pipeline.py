@@ -195,9 +195,9 @@ def analyse(
             later.append(_hard_finding("gouge", "gcode.tool_diameter", err))
     program = None
     if planned is not None:
-        from camcad.export.gcode import render_gcode
+        from camcad.export.gcode import render_program
 
-        program = render_gcode(planned, design.gcode.dialect)
+        program = render_program(planned, design.gcode.dialect)
     return Analysis(
         design=design,
         cam=cam,
@@ -303,7 +303,7 @@ def _write_outputs(
         )
     if "gcode" in groups:
         assert analysis.gcode is not None  # analysed with the toolpath when G-code is asked for
-        program = analysis.gcode
+        program = analysis.gcode.text
         stage("gcode", lambda: write_text(folder / "cam.ngc", program))
     if "report" in groups:
         from camcad.report import write_report

@@ -212,8 +212,8 @@ def test_render_compare_needs_a_design():
         render_compare([])
 
 
-class _Toolpath:
-    """Stands in for the planned toolpath: only its summary is rendered."""
+class _Program:
+    """Stands in for the rendered G-code program: only its summary is rendered."""
 
     def summary(self):
         return {
@@ -227,7 +227,7 @@ class _Toolpath:
 
 
 def test_report_renders_gcode_section(analysis):
-    page = render_report(replace(analysis, toolpath=_Toolpath()))
+    page = render_report(replace(analysis, gcode=_Program()))
     parsed = parse(page)
     assert 'id="table-gcode"' in page
     assert "<finish>" not in page and "<finish>" in parsed.plain

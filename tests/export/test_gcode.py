@@ -10,7 +10,7 @@ import pytest
 
 from camcad.design import Design, Dialect
 from camcad.errors import EXIT_INVALID, CamcadError, DesignError, GcodeSyntaxError, exit_code
-from camcad.export.gcode import count_blocks, parse_gcode, render_gcode, summarize
+from camcad.export.gcode import count_blocks, parse_gcode, render_gcode, render_program
 from camcad.geometry.cam import Cam
 from camcad.toolpath import MoveKind, Toolpath, check_toolpath, plan_toolpath
 from tests.conftest import make_design
@@ -46,8 +46,10 @@ def test_parsed_moves_equal_planned_moves(config):
 
 def test_summary_reports_what_was_written():
     design, _, tp = planned("tabs-bore-coolant")
-    text = render_gcode(tp)
-    summary = summarize(tp, text).as_dict()
+    program = render_program(tp)  # rendered once: the summary counts the text that is written
+    text = program.text
+    assert text == render_gcode(tp)
+    summary = program.summary()
     assert set(summary) == {"blocks", "arcs", "cutting_length_mm", "cycle_time_s", "max_deviation_mm"}
     assert summary["blocks"] == count_blocks(text)
     assert summary["arcs"] == sum(1 for line in text.splitlines() if line.startswith(("G2 ", "G3 ")))

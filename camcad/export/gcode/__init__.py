@@ -4,8 +4,8 @@ The toolpath itself is planned by :mod:`camcad.toolpath`; this package only
 turns it into text and reads programs back.
 
 - :func:`render_gcode` writes a :class:`~camcad.toolpath.Toolpath` in a
-  dialect (``linuxcnc``, ``grbl``, ``generic``); :func:`summarize` gives the
-  figures for summary.json from the toolpath and its rendered text.
+  dialect (``linuxcnc``, ``grbl``, ``generic``); :func:`render_program` also
+  counts the figures for summary.json on the text it rendered.
 - :func:`parse_gcode` and :func:`parse_canon` (LinuxCNC ``rs274`` output)
   read programs back into :class:`~camcad.toolpath.Move` s, for
   :func:`camcad.toolpath.check_toolpath` to prove.
@@ -28,16 +28,25 @@ turns it into text and reads programs back.
 
 from camcad.export.gcode.dialects import DIALECTS, DialectRules, dialect_rules
 from camcad.export.gcode.parse import parse_canon, parse_gcode
-from camcad.export.gcode.writer import GcodeSummary, count_blocks, render_gcode, summarize
+from camcad.export.gcode.writer import (
+    GcodeProgram,
+    GcodeSummary,
+    count_blocks,
+    render_gcode,
+    render_program,
+    summarize,
+)
 
 __all__ = [
     "DIALECTS",
     "DialectRules",
+    "GcodeProgram",
     "GcodeSummary",
     "count_blocks",
     "dialect_rules",
     "parse_canon",
     "parse_gcode",
     "render_gcode",
+    "render_program",
     "summarize",
 ]

@@ -18,7 +18,7 @@ from camcad.toolpath.moves import MoveKind
 if TYPE_CHECKING:
     from camcad.toolpath.plan import Toolpath
 
-__all__ = ["GcodeSummary", "count_blocks", "render_gcode", "summarize"]
+__all__ = ["GcodeProgram", "GcodeSummary", "count_blocks", "render_gcode", "render_program", "summarize"]
 
 
 def _num(v: float) -> str:
@@ -175,3 +175,29 @@ def summarize(toolpath: Toolpath, text: str) -> GcodeSummary:
         cycle_time_s=time if math.isfinite(time) else 0.0,
         max_deviation_mm=toolpath.max_deviation,
     )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GcodeProgram:
+    """A toolpath rendered once: the program text and its figures for summary.json.
+
+    Attributes
+    ----------
+    text
+        The G-code program (what ``cam.ngc`` holds).
+    figures
+        Blocks, arcs, cutting length, cycle time and deviation, counted on ``text``.
+    """
+
+    text: str
+    figures: GcodeSummary
+
+    def summary(self) -> dict[str, Any]:
+        """The ``gcode`` entry of summary.json."""
+        return self.figures.as_dict()
+
+
+def render_program(toolpath: Toolpath, dialect: Dialect | str | None = None) -> GcodeProgram:
+    """Render a toolpath (see :func:`render_gcode`) and summarise what was rendered."""
+    text = render_gcode(toolpath, dialect)
+    return GcodeProgram(text=text, figures=summarize(toolpath, text))
