@@ -30,10 +30,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from camcad.design import load_design
-from camcad.export.gcode import count_blocks, plan_toolpath, render_gcode
-from camcad.export.gcode._contour import offset_curve
-from camcad.export.gcode.biarc import chord_pieces, measure_deviation
+from camcad.export.gcode import count_blocks, render_gcode
 from camcad.geometry.cam import Cam
+from camcad.toolpath import plan_toolpath
+from camcad.toolpath.arcs.biarc import chord_pieces, measure_deviation
+from camcad.toolpath.contour import offset_curve
 
 ROOT = Path(__file__).resolve().parents[1]
 

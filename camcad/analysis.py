@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -22,6 +22,10 @@ from camcad.findings import Finding
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
 from camcad.motion.program import Motion
+
+if TYPE_CHECKING:
+    from camcad.export.gcode import GcodeProgram
+    from camcad.toolpath import Toolpath
 
 __all__ = ["Analysis", "motion_summary"]
 
@@ -41,7 +45,10 @@ class Analysis:
     fit
         The certified NURBS of the profile, or None when not requested.
     toolpath
-        The planned G-code toolpath, or None when not requested.
+        The planned toolpath, or None when not requested.
+    gcode
+        The toolpath rendered once in the design's dialect: the text of
+        ``cam.ngc`` and the summary's figures; None without a toolpath.
     timings
         Seconds per stage.
     stage_findings
@@ -55,7 +62,8 @@ class Analysis:
     geometry: GeometryAnalysis
     dynamics: DynamicsResult
     fit: ProfileFit | None
-    toolpath: Any
+    toolpath: Toolpath | None
+    gcode: GcodeProgram | None = None
     timings: dict[str, float] = field(default_factory=dict)
     stage_findings: tuple[Finding, ...] = ()
 
@@ -86,8 +94,8 @@ class Analysis:
         }
         if self.fit is not None:
             out["fit"] = self.fit.summary()
-        if self.toolpath is not None:
-            out["gcode"] = self.toolpath.summary()
+        if self.gcode is not None:
+            out["gcode"] = self.gcode.summary()
         out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]

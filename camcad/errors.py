@@ -20,11 +20,13 @@ __all__ = [
     "EXIT_OK",
     "EXIT_PIPE_CLOSED",
     "EXIT_UNEXPECTED",
+    "ArcSearchStallError",
     "CamcadError",
     "DesignError",
     "DesignLimitError",
     "ExportError",
     "FitError",
+    "GcodeSyntaxError",
     "GougeError",
     "JumpError",
     "NotStarShapedError",
@@ -176,6 +178,35 @@ class ExportError(CamcadError):
 
 class NotStarShapedError(DesignLimitError, ExportError):
     """A ray from the cam axis meets the profile twice, so a polar table (lift.csv) cannot be written."""
+
+
+class GcodeSyntaxError(CamcadError, ValueError):
+    """A G-code line the reader does not understand (exit 2: bad input).
+
+    Parameters
+    ----------
+    line_no
+        1-based number of the line in the program.
+    line
+        The line as read.
+    why
+        What is wrong with it.
+    """
+
+    exit_code = EXIT_INVALID
+
+    def __init__(self, line_no: int, line: str, why: str) -> None:
+        super().__init__(f"line {line_no}: {why}: {line.strip()!r}")
+        self.line_no = line_no
+
+
+class ArcSearchStallError(CamcadError, ValueError):
+    """The arc search found no arc that passes its measurement (the fit falls back to the biarc march).
+
+    Internal: the arc-spline fit catches it, so it reaching a user is a bug (exit 1).
+    """
+
+    exit_code = EXIT_UNEXPECTED
 
 
 def exit_code(err: BaseException) -> int:

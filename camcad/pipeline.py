@@ -174,7 +174,7 @@ def analyse(
             later.append(_hard_finding("fit tolerance", "fit.tolerance", err))
     planned = None
     if toolpath and not hard:
-        from camcad.export.gcode import plan_toolpath
+        from camcad.toolpath import plan_toolpath
 
         try:
             planned = _timed(
@@ -193,6 +193,11 @@ def analyse(
             if strict:
                 raise
             later.append(_hard_finding("gouge", "gcode.tool_diameter", err))
+    program = None
+    if planned is not None:
+        from camcad.export.gcode import render_program
+
+        program = render_program(planned, design.gcode.dialect)
     return Analysis(
         design=design,
         cam=cam,
@@ -201,6 +206,7 @@ def analyse(
         dynamics=dynamics,
         fit=fitted,
         toolpath=planned,
+        gcode=program,
         timings=timings,
         stage_findings=tuple(later),
     )
@@ -303,12 +309,9 @@ def _write_outputs(
             ),
         )
     if "gcode" in groups:
-        from camcad.export.gcode import render_gcode
-
-        stage(
-            "gcode",
-            lambda: write_text(folder / "cam.ngc", render_gcode(analysis.toolpath, design.gcode.dialect)),
-        )
+        assert analysis.gcode is not None  # analysed with the toolpath when G-code is asked for
+        program = analysis.gcode.text
+        stage("gcode", lambda: write_text(folder / "cam.ngc", program))
     if "report" in groups:
         from camcad.report import write_report
 

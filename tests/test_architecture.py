@@ -46,26 +46,13 @@ LAYER_ORDER: tuple[frozenset[str], ...] = (
 LAYERS: dict[str, int] = {name: rank for rank, names in enumerate(LAYER_ORDER) for name in names}
 DESIGN_READERS_FROM = LAYERS["analysis"]  # this layer and those above may import design
 
-_UNTIL_SPLIT = "until GcodeSpec, Dialect and Direction move into toolpath/ with the planner (issue 13)"
-# Stage modules that import camcad.design today. The list only shrinks: a module that
-# stops importing design must leave it, and a module not in it may not start.
-KNOWN_DESIGN_IMPORTS: dict[str, str] = {
-    "camcad.export.gcode._passes": _UNTIL_SPLIT + " (GcodeSpec options)",
-    "camcad.export.gcode.dialects": _UNTIL_SPLIT + " (Dialect)",
-    "camcad.export.gcode.toolpath": _UNTIL_SPLIT + " (Direction, GcodeSpec)",
-    "camcad.export.gcode.verify": _UNTIL_SPLIT + " (GcodeSpec)",
-    "camcad.export.gcode.writer": _UNTIL_SPLIT + " (Dialect, GcodeSpec)",
-}
+# Stage modules that import camcad.design. The list only shrinks: a module that stops
+# importing design must leave it, and a module not in it may not start. It is empty.
+KNOWN_DESIGN_IMPORTS: dict[str, str] = {}
 
-# Import cycles that exist today, each as the sorted tuple of its modules. The list
-# only shrinks: a new cycle fails, and so does an entry whose cycle is gone.
-KNOWN_CYCLES: dict[tuple[str, ...], str] = {
-    ("camcad.export.gcode.toolpath", "camcad.export.gcode.writer"): (
-        "plan_toolpath calls render_gcode and render_gcode calls plan_toolpath, both through "
-        "imports deferred into the function; the toolpath/ package (issue 13) separates planning "
-        "from writing"
-    ),
-}
+# Import cycles, each as the sorted tuple of its modules. The list only shrinks: a new
+# cycle fails, and so does an entry whose cycle is gone. It is empty.
+KNOWN_CYCLES: dict[tuple[str, ...], str] = {}
 
 
 def _module_name(path: Path) -> str:

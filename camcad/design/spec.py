@@ -1,7 +1,8 @@
 """The validated design: every stage's options gathered in one frozen aggregate.
 
 Each stage owns its options (``motion.segments``, ``geometry.spec``,
-``dynamics.spec``, ``fit.spec``, ``export.spec``); :class:`Design` gathers
+``dynamics.spec``, ``fit.spec``, ``toolpath.spec``,
+``export.spec``); :class:`Design` gathers
 them with the cam plate's own values and hands each stage its own small
 object (``Design.plate()``, ``Design.dynamics_setup()``, ``design.fit`` …).
 Defaults are written once, here and in those dataclasses; the schema
@@ -10,7 +11,6 @@ Defaults are written once, here and in those dataclasses; the schema
 
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass, field, replace
 
@@ -20,25 +20,11 @@ from camcad.fit.spec import FitSpec
 from camcad.geometry.plate import BoreOutline, Plate
 from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
 from camcad.motion.segments import SegmentSpec
+from camcad.toolpath.spec import Dialect, Direction, GcodeSpec
 
 __all__ = ["DEG", "CamSpec", "Design", "Dialect", "Direction", "GcodeSpec"]
 
 DEG = math.pi / 180.0
-
-
-class Dialect(enum.Enum):
-    """G-code dialects."""
-
-    LINUXCNC = "linuxcnc"
-    GRBL = "grbl"
-    GENERIC = "generic"
-
-
-class Direction(enum.Enum):
-    """Milling direction."""
-
-    CLIMB = "climb"
-    CONVENTIONAL = "conventional"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -61,37 +47,6 @@ class CamSpec:
     def omega(self) -> float:
         """Cam angular speed ω [rad/s]."""
         return self.speed_rpm * 2.0 * math.pi / 60.0
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class GcodeSpec:
-    """Milling settings. Lengths mm, feeds mm/min, ``start_angle`` rad."""
-
-    tool_diameter: float = 6.0
-    tool_number: int = 1
-    tolerance: float = 0.005
-    dialect: Dialect = Dialect.LINUXCNC
-    direction: Direction = Direction.CLIMB
-    stock_to_leave: float = 0.2
-    step_down: float = 2.0
-    breakthrough: float = 0.5
-    lead_radius: float | None = None  # None: the tool diameter
-    start_angle: float = 0.0
-    tab_count: int = 0
-    tab_width: float = 6.0
-    tab_height: float = 1.0
-    clearance_height: float = 10.0
-    safe_height: float = 2.0
-    feed: float = 600.0
-    plunge_feed: float = 150.0
-    spindle_rpm: float = 10000.0
-    coolant: bool = False
-    mill_bore: bool = False
-
-    @property
-    def tool_radius(self) -> float:
-        """Tool radius [mm]."""
-        return self.tool_diameter / 2.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -48,7 +48,7 @@ from ezdxf.document import Drawing
 from ezdxf.layouts import Modelspace
 
 from camcad.errors import ExportError
-from camcad.export._contours import flatten_bspline, flatten_curve
+from camcad.export._outline import flatten_bspline, flatten_curve
 from camcad.export.atomic import atomic_write
 from camcad.export.spec import DxfSpec
 from camcad.fit.curve import BSplineCurve

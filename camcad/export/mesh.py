@@ -2,7 +2,7 @@
 
 :func:`build_solid` flattens the fitted profile spline within
 ``[mesh].chord_tolerance`` (a proven bound, see
-:func:`~camcad.export._contours.flatten_bspline`), cuts the bore and keyway as
+:func:`~camcad.export._outline.flatten_bspline`), cuts the bore and keyway as
 one hole, and extrudes the section to ``[cam].thickness`` with manifold3d.
 Every build is checked, and any failure raises
 :class:`~camcad.errors.ExportError`:
@@ -45,7 +45,7 @@ import trimesh
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import ExportError
-from camcad.export._contours import (
+from camcad.export._outline import (
     analytic_area,
     bspline_area,
     bspline_length,

@@ -17,7 +17,7 @@ from scipy.spatial import cKDTree
 
 from camcad.design import Design
 from camcad.errors import ExportError
-from camcad.export._contours import flatten_bspline, polygon_area
+from camcad.export._outline import flatten_bspline, polygon_area
 from camcad.export.dxf import (
     profile_document,
     write_profile_dxf,

@@ -18,7 +18,7 @@ from scipy.interpolate import make_interp_spline
 
 from camcad.design import Design
 from camcad.errors import ExportError
-from camcad.export._contours import (
+from camcad.export._outline import (
     analytic_area,
     bspline_area,
     bspline_length,

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from camcad.export._contours import polygon_area, polygon_perimeter
+from camcad.export._outline import polygon_area, polygon_perimeter
 from tests.readers.conftest import Built, require, run
 
 pytestmark = pytest.mark.slow

@@ -18,15 +18,9 @@ from pathlib import Path
 import pytest
 
 from camcad.design import Design, load_design
-from camcad.export.gcode import (
-    Toolpath,
-    check_toolpath,
-    parse_canon,
-    parse_gcode,
-    plan_toolpath,
-    render_gcode,
-)
+from camcad.export.gcode import parse_canon, parse_gcode, render_gcode
 from camcad.geometry.cam import Cam
+from camcad.toolpath import Toolpath, check_toolpath, plan_toolpath
 from tests.conftest import SAMPLES, make_design
 
 RS274 = shutil.which("rs274")

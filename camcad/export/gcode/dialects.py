@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from camcad.design import Dialect
+from camcad.toolpath.spec import Dialect
 
 __all__ = ["DIALECTS", "DialectRules", "dialect_rules"]
 

@@ -15,10 +15,12 @@ Both start the machine at (0, 0, 0), as ``rs274`` does.
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
-from camcad.export.gcode.moves import Move, MoveKind
+from camcad.errors import GcodeSyntaxError
+from camcad.toolpath.moves import Move, MoveKind
 
-__all__ = ["GcodeSyntaxError", "parse_canon", "parse_gcode"]
+__all__ = ["parse_canon", "parse_gcode"]
 
 _INCH = 25.4
 _WORD = re.compile(r"([A-Z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
@@ -26,22 +28,96 @@ _COMMENT = re.compile(r"\([^)]*\)")
 _CALL = re.compile(r"([A-Z_]+)\((.*)\)\s*$")
 
 
-class GcodeSyntaxError(ValueError):
-    """A G-code line the reader does not understand."""
+class _LineError(Exception):
+    """Why one line cannot be read (turned into a :class:`GcodeSyntaxError` with its line)."""
 
-    def __init__(self, line_no: int, line: str, why: str) -> None:
-        super().__init__(f"line {line_no}: {why}: {line.strip()!r}")
-        self.line_no = line_no
+
+_MOTION = {
+    "0": MoveKind.RAPID, "00": MoveKind.RAPID, "1": MoveKind.LINE, "01": MoveKind.LINE,
+    "2": MoveKind.CW, "02": MoveKind.CW, "3": MoveKind.CCW, "03": MoveKind.CCW,
+}  # fmt: skip
+
+
+@dataclass(slots=True)
+class _Modal:
+    """The reader's machine state: position [mm] and the modal words in force."""
+
+    pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mode: MoveKind | None = None
+    scale: float = 1.0  # mm per program unit (G20: 25.4)
+    absolute: bool = True  # G90 / G91
+    ij_absolute: bool = False  # G90.1 / G91.1
+    feed: float = 0.0  # mm/min
 
 
 def _words(line: str) -> list[tuple[str, float, str]]:
     code = _COMMENT.sub(" ", line.split(";", 1)[0]).upper()
     if "(" in code or ")" in code:
-        raise ValueError("unbalanced comment")
+        raise _LineError("unbalanced comment")
     rest = _WORD.sub(" ", code).strip()
     if rest and rest != "%":
-        raise ValueError(f"cannot read {rest!r}")
+        raise _LineError(f"cannot read {rest!r}")
     return [(m.group(1), float(m.group(2)), m.group(2)) for m in _WORD.finditer(code)]
+
+
+def _g_word(state: _Modal, raw: str, value: float) -> MoveKind | None:
+    """Apply one G word to the modal state; return the motion mode it selects, if any."""
+    if raw in _MOTION:
+        return _MOTION[raw]
+    if value == 20:
+        state.scale = _INCH
+    elif value == 21:
+        state.scale = 1.0
+    elif raw in ("90", "91"):
+        state.absolute = raw == "90"
+    elif raw in ("90.1", "91.1"):
+        state.ij_absolute = raw == "90.1"
+    elif value in (18, 19):
+        raise _LineError("only the XY plane (G17) is supported")
+    return None
+
+
+def _read_words(
+    state: _Modal, words: list[tuple[str, float, str]]
+) -> tuple[MoveKind | None, dict[str, float]]:
+    """Apply a line's words in order; return the motion mode it selects and its axis words."""
+    axes: dict[str, float] = {}
+    motion = None
+    for letter, value, raw in words:
+        if letter == "G":
+            kind = _g_word(state, raw, value)
+            motion = kind if kind is not None else motion
+        elif letter in "XYZIJ":
+            axes[letter] = value
+        elif letter == "R":
+            raise _LineError("R-format arcs are not supported")
+        elif letter == "F":
+            state.feed = value * state.scale
+    return motion, axes
+
+
+def _move(state: _Modal, axes: dict[str, float]) -> Move:
+    """The motion block of a line with axis words, in the current mode; advances the position."""
+    mode = state.mode
+    if mode is None:
+        raise _LineError("coordinates without a motion mode")
+    pos = state.pos
+    end = list(pos)
+    for k, a in enumerate("XYZ"):
+        if a in axes:
+            end[k] = axes[a] * state.scale if state.absolute else pos[k] + axes[a] * state.scale
+    end_t = (end[0], end[1], end[2])
+    if mode is not MoveKind.RAPID and state.feed <= 0.0:
+        raise _LineError("feed move with zero feed rate")
+    center = None
+    if mode.is_arc:
+        if "I" not in axes and "J" not in axes:
+            raise _LineError("arc without I or J")
+        i, j = axes.get("I", 0.0) * state.scale, axes.get("J", 0.0) * state.scale
+        center = (i, j) if state.ij_absolute else (pos[0] + i, pos[1] + j)
+    state.pos = end_t
+    feed = 0.0 if mode is MoveKind.RAPID else state.feed
+    return Move(kind=mode, start=pos, end=end_t, center=center, feed=feed)
 
 
 def parse_gcode(text: str) -> tuple[Move, ...]:
@@ -64,79 +140,17 @@ def parse_gcode(text: str) -> tuple[Move, ...]:
         For unreadable words, a plane other than G17, R-format arcs, or a
         feed move before any feed rate.
     """
-    pos = (0.0, 0.0, 0.0)
-    mode: MoveKind | None = None
-    scale = 1.0
-    absolute = True
-    ij_absolute = False
-    feed = 0.0
+    state = _Modal()
     out: list[Move] = []
     for no, line in enumerate(text.splitlines(), start=1):
         try:
-            words = _words(line)
-        except ValueError as err:
+            motion, axes = _read_words(state, _words(line))
+            if motion is not None:
+                state.mode = motion
+            if any(a in axes for a in "XYZ"):
+                out.append(_move(state, axes))
+        except _LineError as err:
             raise GcodeSyntaxError(no, line, str(err)) from None
-        axes: dict[str, float] = {}
-        motion = None
-        for letter, value, raw in words:
-            if letter == "G":
-                if raw in ("0", "00"):
-                    motion = MoveKind.RAPID
-                elif raw in ("1", "01"):
-                    motion = MoveKind.LINE
-                elif raw in ("2", "02"):
-                    motion = MoveKind.CW
-                elif raw in ("3", "03"):
-                    motion = MoveKind.CCW
-                elif value == 20:
-                    scale = _INCH
-                elif value == 21:
-                    scale = 1.0
-                elif raw == "90":
-                    absolute = True
-                elif raw == "91":
-                    absolute = False
-                elif raw == "90.1":
-                    ij_absolute = True
-                elif raw == "91.1":
-                    ij_absolute = False
-                elif value in (18, 19):
-                    raise GcodeSyntaxError(no, line, "only the XY plane (G17) is supported")
-            elif letter in "XYZIJ":
-                axes[letter] = value
-            elif letter == "R":
-                raise GcodeSyntaxError(no, line, "R-format arcs are not supported")
-            elif letter == "F":
-                feed = value * scale
-        if motion is not None:
-            mode = motion
-        if not any(a in axes for a in "XYZ"):
-            continue
-        if mode is None:
-            raise GcodeSyntaxError(no, line, "coordinates without a motion mode")
-        end = list(pos)
-        for k, a in enumerate("XYZ"):
-            if a in axes:
-                end[k] = axes[a] * scale if absolute else pos[k] + axes[a] * scale
-        end_t = (end[0], end[1], end[2])
-        if mode is not MoveKind.RAPID and feed <= 0.0:
-            raise GcodeSyntaxError(no, line, "feed move with zero feed rate")
-        center = None
-        if mode.is_arc:
-            if "I" not in axes and "J" not in axes:
-                raise GcodeSyntaxError(no, line, "arc without I or J")
-            i, j = axes.get("I", 0.0) * scale, axes.get("J", 0.0) * scale
-            center = (i, j) if ij_absolute else (pos[0] + i, pos[1] + j)
-        out.append(
-            Move(
-                kind=mode,
-                start=pos,
-                end=end_t,
-                center=center,
-                feed=0.0 if mode is MoveKind.RAPID else feed,
-            )
-        )
-        pos = end_t
     return tuple(out)
 
 

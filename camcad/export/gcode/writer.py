@@ -12,15 +12,22 @@ import unicodedata
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
-from camcad.design import Dialect, GcodeSpec
 from camcad.export.gcode.dialects import dialect_rules
-from camcad.export.gcode.moves import MoveKind
+from camcad.toolpath.moves import MoveKind
+from camcad.toolpath.spec import Dialect, GcodeSpec
 
 if TYPE_CHECKING:
-    from camcad.export.gcode.toolpath import Toolpath
-    from camcad.geometry.cam import Cam
+    from camcad.toolpath.plan import Toolpath
 
-__all__ = ["GcodeSummary", "comment_text", "count_blocks", "render_gcode", "summarize", "write_gcode"]
+__all__ = [
+    "GcodeProgram",
+    "GcodeSummary",
+    "comment_text",
+    "count_blocks",
+    "render_gcode",
+    "render_program",
+    "summarize",
+]
 
 
 def _num(v: float) -> str:
@@ -203,14 +210,27 @@ def summarize(toolpath: Toolpath, text: str) -> GcodeSummary:
     )
 
 
-def write_gcode(cam: Cam, spec: GcodeSpec, *, name: str, thickness: float, bore: float = 0.0) -> str:
-    """Plan and render in one call: the G-code text (no file is written).
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GcodeProgram:
+    """A toolpath rendered once: the program text and its figures for summary.json.
 
-    Raises
-    ------
-    GougeError
-        When the tool is larger than a concave radius of the profile.
+    Attributes
+    ----------
+    text
+        The G-code program (what ``cam.ngc`` holds).
+    figures
+        Blocks, arcs, cutting length, cycle time and deviation, counted on ``text``.
     """
-    from camcad.export.gcode.toolpath import plan_toolpath
 
-    return render_gcode(plan_toolpath(cam, spec, name=name, thickness=thickness, bore=bore))
+    text: str
+    figures: GcodeSummary
+
+    def summary(self) -> dict[str, Any]:
+        """The ``gcode`` entry of summary.json."""
+        return self.figures.as_dict()
+
+
+def render_program(toolpath: Toolpath, dialect: Dialect | str | None = None) -> GcodeProgram:
+    """Render a toolpath (see :func:`render_gcode`) and summarise what was rendered."""
+    text = render_gcode(toolpath, dialect)
+    return GcodeProgram(text=text, figures=summarize(toolpath, text))

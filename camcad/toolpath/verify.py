@@ -1,6 +1,6 @@
 """Check a toolpath geometrically against the exact cam, from its moves alone.
 
-The moves may come from the planner, from :func:`~camcad.export.gcode.parse.parse_gcode`
+The moves may come from the planner, from :func:`camcad.export.gcode.parse.parse_gcode`
 or from LinuxCNC's canonical output (:func:`~camcad.export.gcode.parse.parse_canon`),
 so the same proof runs on what a controller would execute. Nothing here
 uses the planner's internals: passes are found from the motion itself.
@@ -16,9 +16,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from camcad._typing import FloatArray
-from camcad.design import Direction, GcodeSpec
-from camcad.export.gcode.moves import Move, MoveKind
 from camcad.geometry.cam import Cam
+from camcad.toolpath.moves import Move, MoveKind
+from camcad.toolpath.spec import Direction, GcodeSpec
 
 __all__ = ["ToolpathCheck", "check_toolpath", "densify", "distance_to_polyline"]
 
@@ -248,36 +248,73 @@ def check_toolpath(
     chords (error below 1e-4 mm for path radii above 0.5 mm).
     """
     r = spec.tool_radius
-    offset = _Projector(cam, r)
-    profile = _Projector(cam, 0.0)
     depth = thickness + spec.breakthrough
     runs = _runs(moves)
     bore_r = bore / 2.0
     pts_by_run = [np.vstack([densify(m) for m in run]) for run in runs]
     is_bore = [bore_r > 0.0 and bool(np.all(np.hypot(p[:, 0], p[:, 1]) < bore_r + 1e-6)) for p in pts_by_run]
     profile_runs = [run for run, b in zip(runs, is_bore, strict=True) if not b]
+    levels, missing = _levels(profile_runs, depth, spec.step_down)
+    finish = profile_runs[-1] if profile_runs else []
+    hausdorff, direction, final_depth = _measure_finish(finish, _Projector(cam, r))
+    feed_pts = np.vstack(pts_by_run) if pts_by_run else np.zeros((0, 3))
+    clearance, bore_excess = _clearance(feed_pts, _Projector(cam, 0.0), r, bore_r)
+    mismatch = max((abs(m.radii[0] - m.radii[1]) for m in moves if m.kind.is_arc), default=0.0)
+    return ToolpathCheck(
+        hausdorff=hausdorff,
+        min_clearance=clearance,
+        bore_excess=bore_excess,
+        levels=levels,
+        missing_levels=missing,
+        low_rapids=_low_rapids(moves, spec.safe_height),
+        max_radius_mismatch=mismatch,
+        direction=direction,
+        final_depth=final_depth,
+        tolerance=spec.tolerance,
+        expected_direction=spec.direction,
+        expected_depth=-depth,
+    )
+
+
+def _levels(
+    profile_runs: Sequence[Sequence[Move]], depth: float, step_down: float
+) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Depths [mm] of the profile passes found (top down), and the step-down levels with no pass."""
     levels = tuple(sorted({round(min(m.end[2] for m in run), 4) for run in profile_runs}, reverse=True))
-    n_levels = max(1, math.ceil(depth / spec.step_down - 1e-9))
+    n_levels = max(1, math.ceil(depth / step_down - 1e-9))
     expected = [-depth * k / n_levels for k in range(1, n_levels + 1)]
     missing = tuple(z for z in expected if not any(abs(z - lv) <= _LEVEL_TOL for lv in levels))
-    # finishing contour, leads excluded
-    finish = profile_runs[-1] if profile_runs else []
+    return levels, missing
+
+
+def _measure_finish(finish: Sequence[Move], offset: _Projector) -> tuple[float, Direction, float]:
+    """Hausdorff distance, milling direction and depth of the finishing contour.
+
+    The contour is the finishing pass without its first and last planar
+    moves (the leads); the distance [mm] is two-way, to the exact offset
+    curve; the depth [mm] is its lowest Z.
+    """
     planar = [m for m in finish if _planar(m)]
     contour = planar[1:-1]
-    if contour:
-        c_pts = np.vstack([densify(m) for m in contour])
-        xy = c_pts[:, :2]
-        to_exact = offset(xy, bound=1.0)
-        to_path = distance_to_polyline(offset.dense(_EXACT_SAMPLES), xy, bound=1.0)
-        hausdorff = float(max(to_exact.max(), to_path.max()))
-        x, y = xy[:, 0], xy[:, 1]
-        area = 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-        final_depth = float(min(m.end[2] for m in contour))
-    else:
-        hausdorff, area, final_depth = math.inf, 0.0, 0.0
+    if not contour:
+        return math.inf, Direction.CONVENTIONAL, 0.0
+    xy = np.vstack([densify(m) for m in contour])[:, :2]
+    to_exact = offset(xy, bound=1.0)
+    to_path = distance_to_polyline(offset.dense(_EXACT_SAMPLES), xy, bound=1.0)
+    hausdorff = float(max(to_exact.max(), to_path.max()))
+    x, y = xy[:, 0], xy[:, 1]
+    area = 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
     direction = Direction.CLIMB if area < 0.0 else Direction.CONVENTIONAL
-    # clearance from the profile, for every feed move below the stock top
-    feed_pts = np.vstack(pts_by_run) if pts_by_run else np.zeros((0, 3))
+    return hausdorff, direction, float(min(m.end[2] for m in contour))
+
+
+def _clearance(feed_pts: FloatArray, profile: _Projector, r: float, bore_r: float) -> tuple[float, float]:
+    """Smallest clearance from the profile and largest reach beyond the bore wall [mm].
+
+    Over the feed points (n, 3) below the stock top: the clearance is the
+    distance to the exact profile minus the tool radius ``r``; points inside
+    the bore radius ``bore_r`` are measured against the bore wall instead.
+    """
     below = feed_pts[feed_pts[:, 2] < 0.0]
     inside = np.hypot(below[:, 0], below[:, 1]) < bore_r if bore_r > 0 else np.zeros(len(below), bool)
     outer = below[~inside]
@@ -287,24 +324,14 @@ def check_toolpath(
     bore_excess = (
         float(max(0.0, (np.hypot(in_bore[:, 0], in_bore[:, 1]) + r - bore_r).max())) if len(in_bore) else 0.0
     )
-    floor = spec.safe_height - 1e-9
-    low = sum(
+    return clearance, bore_excess
+
+
+def _low_rapids(moves: Sequence[Move], safe_height: float) -> int:
+    """Rapids that start or end below the safe height [mm] (the first move's unknown start excepted)."""
+    floor = safe_height - 1e-9
+    return sum(
         1
         for i, m in enumerate(moves)
         if m.kind is MoveKind.RAPID and (m.end[2] < floor or (i > 0 and m.start[2] < floor))
-    )
-    mismatch = max((abs(m.radii[0] - m.radii[1]) for m in moves if m.kind.is_arc), default=0.0)
-    return ToolpathCheck(
-        hausdorff=hausdorff,
-        min_clearance=clearance,
-        bore_excess=bore_excess,
-        levels=levels,
-        missing_levels=missing,
-        low_rapids=low,
-        max_radius_mismatch=mismatch,
-        direction=direction,
-        final_depth=final_depth,
-        tolerance=spec.tolerance,
-        expected_direction=spec.direction,
-        expected_depth=-depth,
     )

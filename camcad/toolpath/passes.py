@@ -10,10 +10,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from camcad.design import Direction, GcodeSpec
 from camcad.errors import DesignError
-from camcad.export.gcode._contour import Contour, round_mm, round_point
-from camcad.export.gcode.moves import Move, MoveKind
+from camcad.toolpath.contour import Contour, round_mm, round_point
+from camcad.toolpath.moves import Move, MoveKind
+from camcad.toolpath.spec import Direction, GcodeSpec
 
 __all__ = ["Program", "check_bore", "cut_contour", "lead_points", "mill_bore"]
 

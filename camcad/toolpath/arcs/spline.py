@@ -1,13 +1,13 @@
 """Arc splines: tangent-continuous circular arcs fitted to an exact curve within a measured tolerance.
 
-:func:`fit_curve` fits each φ-interval between break nodes with single arcs,
+:func:`fit_arc_spline` fits each φ-interval between break nodes with single arcs,
 each leaving along the previous arc's end tangent and ending anywhere in the
 tolerance band, found by the layered search of
-:mod:`camcad.export.gcode._arcsearch`; the interval closes with a measured
+:mod:`camcad.toolpath.arcs.search`; the interval closes with a measured
 biarc onto the break node, which stays on the curve with its exact tangent.
 Where that search stalls it falls back to the biarc march of
-:mod:`camcad.export.gcode.biarc`. Every accepted piece's two-way deviation is
-measured (:func:`~camcad.export.gcode.biarc.measure_deviation`), so the
+:mod:`camcad.toolpath.arcs.march`. Every accepted piece's two-way deviation is
+measured (:func:`~camcad.toolpath.arcs.biarc.measure_deviation`), so the
 tolerance never rests on an estimate.
 """
 
@@ -19,13 +19,15 @@ from collections.abc import Sequence
 import numpy as np
 
 from camcad._typing import FloatArray, readonly
-from camcad.export.gcode._arcsearch import search_arcs
-from camcad.export.gcode.biarc import CurveFn, Pieces, _biarc_march, concat_pieces
+from camcad.errors import ArcSearchStallError
+from camcad.toolpath.arcs.biarc import CurveFn, Pieces, concat_pieces
+from camcad.toolpath.arcs.march import march_arcs
+from camcad.toolpath.arcs.search import search_arcs
 
-__all__ = ["fit_curve"]
+__all__ = ["fit_arc_spline"]
 
 
-def fit_curve(
+def fit_arc_spline(
     curve: CurveFn,
     breaks: Sequence[float] | FloatArray,
     tolerance: float,
@@ -79,20 +81,20 @@ def fit_curve(
     moved inside the band (±0.4 tol along the normal, tangent turned by
     ±2 tol/chord) and the joint moved (d₁/d of 0.75 or 1.33). Chords use
     that march. Every accepted interval has been measured
-    (:func:`measure_deviation`), so the tolerance does not rest on an
+    (:func:`~camcad.toolpath.arcs.biarc.measure_deviation`), so the tolerance does not rest on an
     error estimate.
     """
     edges = np.asarray(breaks, dtype=float)
     if not arcs:
-        return _biarc_march(curve, edges, tolerance, arcs=False)
+        return march_arcs(curve, edges, tolerance, arcs=False)
     soft = [float(v) for v in np.asarray(nodes, dtype=float).ravel()]
     parts: list[Pieces] = []
     devs: list[FloatArray] = []
     for a, b in itertools.pairwise(edges):
         try:
             done, dev = search_arcs(curve, float(a), float(b), tolerance, soft=soft)
-        except ValueError:
-            fallback, fdev = _biarc_march(curve, np.array([a, b]), tolerance, arcs=True)
+        except ArcSearchStallError:
+            fallback, fdev = march_arcs(curve, np.array([a, b]), tolerance, arcs=True)
             done, dev = [fallback], [fdev]
         parts += done
         devs += dev

@@ -5,7 +5,7 @@ The curve is any smooth plane curve C(φ) given with its first two
 replaces a φ-interval by two circular arcs that meet the curve's end points
 and end tangents and join each other tangentially; :func:`measure_deviation`
 gives the two-way distance between pieces and the curve, measured on samples
-of both. The arc-spline fit in :mod:`camcad.export.gcode.arcspline` builds on
+of both. The arc-spline fit in :mod:`camcad.toolpath.arcs.spline` builds on
 these.
 
 Pieces are held in :class:`Pieces`, a set of arrays of shape (n, 2, ...): two
@@ -18,7 +18,6 @@ rounded output is measured that way).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -29,24 +28,23 @@ from camcad._typing import FloatArray, readonly
 __all__ = [
     "CurveFn",
     "Pieces",
+    "angle_of",
+    "arc_from_tangent",
     "biarc_pieces",
     "chord_pieces",
+    "concat_pieces",
+    "cross",
+    "curve_nodes",
+    "distance_to_pieces",
     "measure_deviation",
     "sample_pieces",
+    "take_pieces",
 ]
 
 CurveFn = Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
 """φ (n,) [rad] → point (n, 2) [mm], dC/dφ (n, 2) [mm/rad], d²C/dφ² (n, 2) [mm/rad²]."""
 
 _STRAIGHT_SAGITTA = 1e-9  # mm: an arc bulging less than this is a line
-_LADDER = 40  # candidate end angles per march step
-_RATIOS = (0.75, 1.0, 1.33)
-# stage 2 of a march step: reach × these, with the end node moved by
-# (δ/tol, θ·chord/tol): δ along the normal, θ a turn of the end tangent
-_GROW = np.array([1.0, 1.06, 1.12, 1.19, 1.26, 1.34, 1.42, 1.5, 1.6, 1.8])
-_SHIFTS = np.array([(d, t, q) for d in (-0.4, 0.0, 0.4) for t in (-2.0, 0.0, 2.0) for q in _RATIOS])
-_MAX_STEPS = 100_000
-_MIN_SPAN = 1e-9  # rad: an interval this short that still fails cannot be fitted
 _SAMPLES = 24  # per interval and direction while fitting
 _NEWTON_STEPS = 3
 
@@ -85,8 +83,8 @@ class Pieces:
 
     def sweep(self) -> FloatArray:
         """(n, 2) signed sweep angle of each arc [rad], + counter-clockwise; 0 for lines."""
-        a0 = _angle(self.start - self.center)
-        a1 = _angle(self.end - self.center)
+        a0 = angle_of(self.start - self.center)
+        a1 = angle_of(self.end - self.center)
         turn = np.mod(a1 - a0, 2.0 * np.pi)
         out = np.where(self.ccw, turn, turn - 2.0 * np.pi)
         out = np.where(turn == 0.0, 0.0, out)
@@ -99,11 +97,13 @@ class Pieces:
         return np.where(self.line, chord, np.abs(self.sweep()) * radius)
 
 
-def _angle(v: FloatArray) -> FloatArray:
+def angle_of(v: FloatArray) -> FloatArray:
+    """Direction angle [rad] of 2-D vectors (..., 2), in (−π, π]."""
     return np.arctan2(v[..., 1], v[..., 0])
 
 
-def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+def cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """z-component of the cross product of 2-D vectors (..., 2)."""
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
@@ -111,7 +111,7 @@ def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
     return np.einsum("...i,...i->...", a, b)
 
 
-def _arc_from_tangent(
+def arc_from_tangent(
     p: FloatArray, t: FloatArray, q: FloatArray
 ) -> tuple[FloatArray, FloatArray, np.ndarray, np.ndarray]:
     """The arc leaving ``p`` along unit tangent ``t`` and ending at ``q``.
@@ -121,9 +121,9 @@ def _arc_from_tangent(
     """
     w = q - p
     ww = _dot(w, w)
-    cross = _cross(t, w)
+    turn = cross(t, w)
     with np.errstate(divide="ignore", invalid="ignore"):
-        kappa = np.where(ww > 0.0, 2.0 * cross / ww, 0.0)
+        kappa = np.where(ww > 0.0, 2.0 * turn / ww, 0.0)
     line = np.abs(kappa) * ww / 8.0 <= _STRAIGHT_SAGITTA  # sagitta ≈ κ|w|²/8
     safe = np.where(line, 1.0, kappa)
     left = np.stack((-t[..., 1], t[..., 0]), axis=-1)
@@ -193,9 +193,9 @@ def biarc_pieces(
     q0 = p0 + d1[:, None] * t0
     q1 = p1 - d2[:, None] * t1
     joint = q0 + (d1 / (d1 + d2))[:, None] * (q1 - q0)
-    c1, r1, ccw1, line1 = _arc_from_tangent(p0, t0, joint)
+    c1, r1, ccw1, line1 = arc_from_tangent(p0, t0, joint)
     # the second arc, traced backwards from P1 along −T1, is the same circle
-    c2, r2, ccw2, line2 = _arc_from_tangent(p1, -t1, joint)
+    c2, r2, ccw2, line2 = arc_from_tangent(p1, -t1, joint)
     out = Pieces(
         lo=np.asarray(lo, dtype=float),
         hi=np.asarray(hi, dtype=float),
@@ -235,14 +235,14 @@ def sample_pieces(pieces: Pieces, m: int) -> FloatArray:
     u = (np.arange(m) + 1.0) / (m + 1.0)
     start, end = pieces.start[..., None, :], pieces.end[..., None, :]
     on_line = start + (end - start) * u[:, None]
-    a0 = _angle(pieces.start - pieces.center)[..., None]
+    a0 = angle_of(pieces.start - pieces.center)[..., None]
     ang = a0 + pieces.sweep()[..., None] * u
     rad = pieces.r_start[..., None] + (pieces.r_end - pieces.r_start)[..., None] * u
     on_arc = pieces.center[..., None, :] + rad[..., None] * np.stack((np.cos(ang), np.sin(ang)), axis=-1)
     return np.where(pieces.line[..., None, None], on_line, on_arc)
 
 
-def _distance_to_pieces(q: FloatArray, pieces: Pieces) -> FloatArray:
+def distance_to_pieces(q: FloatArray, pieces: Pieces) -> FloatArray:
     """Distance [mm] from points q (n, m, 2) to the nearer piece of their own interval.
 
     Exact for lines and circular arcs; for a spiral (r_start ≠ r_end) the mean
@@ -260,7 +260,7 @@ def _distance_to_pieces(q: FloatArray, pieces: Pieces) -> FloatArray:
         radius = 0.5 * (pieces.r_start[:, k] + pieces.r_end[:, k])[:, None]
         spiral = 0.5 * np.abs(pieces.r_end[:, k] - pieces.r_start[:, k])[:, None]
         sweep = pieces.sweep()[:, k, None]
-        rel = _angle(q - c) - _angle(s - c)
+        rel = angle_of(q - c) - angle_of(s - c)
         along = np.where(sweep >= 0.0, np.mod(rel, 2.0 * np.pi), np.mod(-rel, 2.0 * np.pi))
         inside = along <= np.abs(sweep)
         radial = np.abs(np.linalg.norm(q - c, axis=-1) - radius) + spiral
@@ -344,7 +344,7 @@ def measure_deviation(curve: CurveFn, pieces: Pieces, *, samples: int = _SAMPLES
     phi = pieces.lo[:, None] + (pieces.hi - pieces.lo)[:, None] * u
     q, _, _ = curve(phi.ravel())
     q = q.reshape(n, samples, 2)
-    to_pieces = _peak(_distance_to_pieces(q, pieces))
+    to_pieces = _peak(distance_to_pieces(q, pieces))
     half = max(samples // 2, 2)
     pts = sample_pieces(pieces, half).reshape(n, 2 * half, 2)
     ends, _, _ = curve(np.concatenate((pieces.lo, pieces.hi)))
@@ -361,23 +361,14 @@ def measure_deviation(curve: CurveFn, pieces: Pieces, *, samples: int = _SAMPLES
     return out
 
 
-Builder = Callable[[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray], Pieces]
-
-
-def _build(curve: CurveFn, lo: FloatArray, hi: FloatArray, builder: Builder) -> Pieces:
-    pt, d1, _ = curve(np.concatenate((lo, hi)))
-    tan = d1 / np.linalg.norm(d1, axis=1)[:, None]
-    n = lo.size
-    return builder(lo, hi, pt[:n], tan[:n], pt[n:], tan[n:])
-
-
-def _node(curve: CurveFn, phi: FloatArray) -> tuple[FloatArray, FloatArray]:
+def curve_nodes(curve: CurveFn, phi: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Points (n, 2) and unit tangents (n, 2) of the curve at φ."""
     pt, d1, _ = curve(phi)
     return np.array(pt, dtype=float), d1 / np.linalg.norm(d1, axis=1)[:, None]
 
 
-def _take(p: Pieces, keep: np.ndarray) -> Pieces:
+def take_pieces(p: Pieces, keep: np.ndarray) -> Pieces:
+    """The intervals of ``p`` selected by ``keep`` (indices or a boolean mask)."""
     return Pieces(
         lo=p.lo[keep], hi=p.hi[keep], start=p.start[keep], end=p.end[keep], center=p.center[keep],
         r_start=p.r_start[keep], r_end=p.r_end[keep], ccw=p.ccw[keep], line=p.line[keep],
@@ -390,67 +381,3 @@ def concat_pieces(parts: Sequence[Pieces]) -> Pieces:
     joined = {f: np.concatenate([getattr(p, f) for p in parts]) for f in fields}
     order = np.argsort(joined["lo"], kind="stable")
     return Pieces(**{f: v[order] for f, v in joined.items()})
-
-
-def _biarc_march(
-    curve: CurveFn, edges: FloatArray, tolerance: float, arcs: bool
-) -> tuple[Pieces, FloatArray]:
-    """Greedy march of biarcs (or chords) with end nodes on or near the curve."""
-    builder: Builder = biarc_pieces if arcs else chord_pieces
-    cur, stop = edges[:-1].copy(), edges[1:].copy()
-    cur_p, cur_t = _node(curve, cur)
-    scale = np.ones_like(cur)
-    done: list[Pieces] = []
-    devs: list[FloatArray] = []
-    ladder = 2.0 ** (-np.arange(_LADDER) / 4.0)  # 1 … ~1/1000 of the remaining span
-    shifts = _SHIFTS if arcs else np.array([[0.0, 0.0, 1.0]])
-    for _ in range(_MAX_STEPS):
-        active = np.flatnonzero(cur < stop)
-        if active.size == 0:
-            break
-        span = (stop - cur)[active] * scale[active]
-        if np.any(span < _MIN_SPAN):
-            where = math.degrees(float(cur[active][np.argmin(span)]))
-            raise ValueError(f"cannot fit the curve within {tolerance:g} mm near φ = {where:.3f}°")
-        # stage 1: the farthest rung of a geometric ladder, end node on the curve
-        rep = np.repeat(active, _LADDER)
-        b = np.minimum(cur[rep] + np.repeat(span, _LADDER) * np.tile(ladder, active.size), stop[rep])
-        p1, t1 = _node(curve, b)
-        dev = measure_deviation(curve, builder(cur[rep], b, cur_p[rep], cur_t[rep], p1, t1))
-        ok = (dev <= tolerance).reshape(-1, _LADDER)
-        found = ok.any(axis=1)
-        scale[active[~found]] *= ladder[-1]
-        if not found.any():
-            continue
-        rows = active[found]
-        reach = b.reshape(-1, _LADDER)[found, ok[found].argmax(axis=1)] - cur[rows]
-        # stage 2: reach a little farther, moving the end node within the band
-        grow = np.repeat(rows, _GROW.size * len(shifts))
-        b2 = np.minimum(cur[grow] + np.repeat(np.outer(reach, _GROW).ravel(), len(shifts)), stop[grow])
-        shift = np.tile(shifts, (rows.size * _GROW.size, 1))
-        p2, t2 = _node(curve, b2)
-        chord = np.maximum(np.linalg.norm(p2 - cur_p[grow], axis=1), 1e-12)
-        at_stop = b2 >= stop[grow]
-        delta = np.where(at_stop, 0.0, shift[:, 0] * tolerance)
-        theta = np.where(at_stop, 0.0, shift[:, 1] * tolerance / chord)
-        p2 = p2 + delta[:, None] * np.column_stack((-t2[:, 1], t2[:, 0]))
-        c, s_ = np.cos(theta), np.sin(theta)
-        t2 = np.column_stack((c * t2[:, 0] - s_ * t2[:, 1], s_ * t2[:, 0] + c * t2[:, 1]))
-        if arcs:
-            pieces = biarc_pieces(cur[grow], b2, cur_p[grow], cur_t[grow], p2, t2, ratio=shift[:, 2])
-        else:
-            pieces = builder(cur[grow], b2, cur_p[grow], cur_t[grow], p2, t2)
-        dev = measure_deviation(curve, pieces)
-        # the farthest passing candidate, the one with the least deviation among equals
-        score = np.where(dev <= tolerance, b2 - cur[grow] - 1e-12 * dev / tolerance, -np.inf)
-        pick = np.arange(rows.size) * (_GROW.size * len(shifts)) + score.reshape(rows.size, -1).argmax(axis=1)
-        done.append(_take(pieces, pick))
-        devs.append(dev[pick])
-        cur[rows], cur_p[rows], cur_t[rows] = b2[pick], p2[pick], t2[pick]
-        scale[rows] = 1.0
-    else:  # pragma: no cover - needs a pathological curve
-        raise ValueError(f"cannot fit the curve within {tolerance:g} mm in {_MAX_STEPS} steps")
-    out = concat_pieces(done)
-    dev_all = np.concatenate(devs)[np.argsort(np.concatenate([p.lo for p in done]), kind="stable")]
-    readonly(dev_all)
-    return out, dev_all

@@ -19,17 +19,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from camcad._typing import FloatArray
-from camcad.export.gcode.biarc import (
+from camcad.errors import ArcSearchStallError
+from camcad.toolpath.arcs.biarc import (
     CurveFn,
     Pieces,
-    _angle,
-    _arc_from_tangent,
-    _cross,
-    _distance_to_pieces,
-    _node,
-    _take,
+    angle_of,
+    arc_from_tangent,
     biarc_pieces,
+    cross,
+    curve_nodes,
+    distance_to_pieces,
     measure_deviation,
+    take_pieces,
 )
 
 __all__ = ["search_arcs"]
@@ -62,7 +63,7 @@ class _Layer:
 
 def _single(lo: FloatArray, hi: FloatArray, p: FloatArray, t: FloatArray, q: FloatArray) -> Pieces:
     """One arc per interval (from p along t to q), then an empty second piece at q."""
-    center, radius, ccw, line = _arc_from_tangent(p, t, q)
+    center, radius, ccw, line = arc_from_tangent(p, t, q)
     zero = np.zeros_like(radius)
     return Pieces(
         lo=lo, hi=hi, start=np.stack((p, q), axis=1), end=np.stack((q, q), axis=1),
@@ -110,7 +111,7 @@ def _screen(
     e = np.minimum(j[:, None] + np.maximum(np.rint(frac[None, :] * span[:, None]).astype(int), 1), n)
     q = pts[e][:, :, None, :] + (_AIM_OFFSETS * band)[None, None, :, None] * nrm[e][:, :, None, :]
     w = q - p[:, None, None, :]
-    kappa = 2.0 * _cross(t[:, None, None, :], w) / np.maximum(np.sum(w * w, axis=-1), 1e-300)
+    kappa = 2.0 * cross(t[:, None, None, :], w) / np.maximum(np.sum(w * w, axis=-1), 1e-300)
     kappa = kappa.reshape(j.size, -1)
     w = pts[idx] - p[:, None, :]
     a = np.einsum("swi,si->sw", w, t)
@@ -161,7 +162,7 @@ def _expand(
     s_i, kk, end, off, turn, last = (np.concatenate(f) for f in zip(*found, strict=True))
     if s_i.size == 0:
         return s_i, end, kk
-    ang = _angle(t)[s_i] + turn - tan_ang[end]
+    ang = angle_of(t)[s_i] + turn - tan_ang[end]
     ang = (ang + np.pi) % (2.0 * np.pi) - np.pi
     scale = max(float(np.quantile(np.abs(ang[last]), 0.9)) / _TURN_CELLS, 1e-12)
     ob = np.clip(((off / band + 1.0) * 0.5 * _OFFSET_CELLS).astype(int), 0, _OFFSET_CELLS - 1)
@@ -208,11 +209,11 @@ def _close(
         pc = biarc_pieces(
             phi[layer.j[s]], np.full(s.size, phi[n]), layer.p[s], layer.t[s], end, end_t, ratio=ratio
         )
-        gap = _distance_to_pieces(pts[at], pc).max(axis=1)
+        gap = distance_to_pieces(pts[at], pc).max(axis=1)
     # within tol of the node a biarc could loop unseen: only a state on the node's tangent closes there;
     # elsewhere the biarc may not turn much more than the curve does (no loops)
     apart = np.linalg.norm(layer.p[s] - end, axis=1) > tol
-    aligned = (np.abs(_cross(layer.t[s], end_t)) <= 1e-12) & (np.sum(layer.t[s] * end_t, axis=1) > 0.0)
+    aligned = (np.abs(cross(layer.t[s], end_t)) <= 1e-12) & (np.sum(layer.t[s] * end_t, axis=1) > 0.0)
     turn = np.abs(np.diff(np.unwrap(tan_ang[at], axis=1), axis=1)).sum(axis=1)
     with np.errstate(invalid="ignore"):
         plain = np.abs(pc.sweep()).sum(axis=1) <= turn + _CLOSE_TURN
@@ -220,12 +221,12 @@ def _close(
     if fits.size == 0:
         return None
     with np.errstate(divide="ignore", invalid="ignore"):
-        dev = measure_deviation(curve, _take(pc, fits))
+        dev = measure_deviation(curve, take_pieces(pc, fits))
     dev = np.where(np.isfinite(dev), dev, np.inf)
     i = int(dev.argmin())
     if dev[i] > tol:
         return None
-    return int(s[fits[i]]), _take(pc, fits[i : i + 1]), float(dev[i])
+    return int(s[fits[i]]), take_pieces(pc, fits[i : i + 1]), float(dev[i])
 
 
 def search_arcs(
@@ -239,13 +240,13 @@ def search_arcs(
 
     Raises
     ------
-    ValueError
+    ArcSearchStallError
         When no arc from some layer passes the measurement even in a band
         shrunk to 0.2 tol.
     """
     phi, stops = _table(a, b, soft)
-    pts, tan = _node(curve, phi)
-    tan_ang = _angle(tan)
+    pts, tan = curve_nodes(curve, phi)
+    tan_ang = angle_of(tan)
     nrm = _left(tan)
     layers = [_Layer(np.zeros(1, int), pts[:1], tan[:1], np.zeros(1, int), None, np.zeros(1))]
     width = 64
@@ -265,17 +266,17 @@ def search_arcs(
             if keep.any():
                 break
             if band < 0.2 * tolerance:
-                raise ValueError("arc search stalled")
+                raise ArcSearchStallError("arc search stalled")
             band *= 0.8
         s, end, kappa, dev = s[keep], end[keep], kappa[keep], dev[keep]
-        pc = _take(pc, keep)
+        pc = take_pieces(pc, keep)
         turn = 2.0 * np.arctan2(
-            _cross(layer.t[s], q[keep] - layer.p[s]), np.sum((q[keep] - layer.p[s]) * layer.t[s], axis=-1)
+            cross(layer.t[s], q[keep] - layer.p[s]), np.sum((q[keep] - layer.p[s]) * layer.t[s], axis=-1)
         )
         t2 = np.cos(turn)[:, None] * layer.t[s] + np.sin(turn)[:, None] * _left(layer.t[s])
         layers.append(_Layer(end, q[keep], t2, s, pc, dev))
         width = max(32, int(1.5 * np.median(end - layer.j[s])))
-    raise ValueError("arc search did not close")  # pragma: no cover
+    raise ArcSearchStallError("arc search did not close")  # pragma: no cover
 
 
 def _pick(layer: _Layer, keep: np.ndarray) -> _Layer:
@@ -288,7 +289,7 @@ def _trace(
     pieces, devs = [close], [np.array([dev])]
     for layer in reversed(layers[1:]):
         assert layer.arc is not None
-        pieces.append(_take(layer.arc, np.array([state])))
+        pieces.append(take_pieces(layer.arc, np.array([state])))
         devs.append(layer.dev[state : state + 1])
         state = int(layer.parent[state])
     return pieces[::-1], devs[::-1]

@@ -11,13 +11,16 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.spatial import cKDTree
 
-from camcad.export.gcode.arcspline import fit_curve
-from camcad.export.gcode.biarc import (
+from camcad.errors import ArcSearchStallError
+from camcad.toolpath.arcs import spline
+from camcad.toolpath.arcs.biarc import (
     biarc_pieces,
     chord_pieces,
     measure_deviation,
     sample_pieces,
 )
+from camcad.toolpath.arcs.search import search_arcs
+from camcad.toolpath.arcs.spline import fit_arc_spline
 
 
 def ellipse(a: float, b: float):
@@ -107,7 +110,7 @@ def test_biarc_meets_ends_and_joins_tangentially(x, y, a0, a1, ratio):
 
 def test_circle_is_one_exact_biarc_per_break():
     circle = ellipse(40.0, 40.0)
-    pieces, dev = fit_curve(circle, np.linspace(0.0, 2 * np.pi, 5), 1e-4)
+    pieces, dev = fit_arc_spline(circle, np.linspace(0.0, 2 * np.pi, 5), 1e-4)
     assert len(pieces) == 4
     assert dev.max() < 1e-9
     assert_allclose(pieces.r_start, 40.0, rtol=1e-9)
@@ -118,9 +121,13 @@ def test_circle_is_one_exact_biarc_per_break():
 @pytest.mark.parametrize("name", ["ellipse", "wobble"])
 def test_fit_stays_within_tolerance_by_independent_measure(name, tol):
     curve = ellipse(60.0, 35.0) if name == "ellipse" else wobble()
-    pieces, dev = fit_curve(curve, np.linspace(0.0, 2 * np.pi, 5), tol)
+    pieces, dev = fit_arc_spline(curve, np.linspace(0.0, 2 * np.pi, 5), tol)
     assert dev.max() <= tol
-    # independent two-way check on dense samples of both curves
+    assert_two_way_within(curve, pieces, tol)
+
+
+def assert_two_way_within(curve, pieces, tol):
+    """Independent two-way check on dense samples of both the curve and the pieces."""
     exact = curve(np.linspace(0.0, 2 * np.pi, 40001))[0]
     samples = sample_pieces(pieces, 400)  # chord sagitta < 1e-6 mm
     lengths = pieces.length()
@@ -138,15 +145,15 @@ def test_fit_stays_within_tolerance_by_independent_measure(name, tol):
 
 
 def test_pieces_are_g1_continuous_across_intervals():
-    pieces, _ = fit_curve(wobble(), np.linspace(0.0, 2 * np.pi, 7), 0.002)
+    pieces, _ = fit_arc_spline(wobble(), np.linspace(0.0, 2 * np.pi, 7), 0.002)
     assert_allclose(pieces.end[:-1, 1], pieces.start[1:, 0], atol=0)
     assert_allclose(pieces.end[:, 0], pieces.start[:, 1], atol=0)
 
 
 def test_biarcs_need_far_fewer_blocks_than_chords():
     curve = ellipse(60.0, 35.0)
-    arcs, _ = fit_curve(curve, np.linspace(0.0, 2 * np.pi, 5), 0.004)
-    chords, _ = fit_curve(curve, np.linspace(0.0, 2 * np.pi, 5), 0.004, arcs=False)
+    arcs, _ = fit_arc_spline(curve, np.linspace(0.0, 2 * np.pi, 5), 0.004)
+    chords, _ = fit_arc_spline(curve, np.linspace(0.0, 2 * np.pi, 5), 0.004, arcs=False)
     assert 2 * len(arcs) * 3 < len(chords)
 
 
@@ -184,7 +191,7 @@ def _piece_tangents(pieces):
 def test_soft_nodes_end_an_arc_in_the_band_of_one_closed_interval():
     curve, tol = wobble(), 0.004
     nodes = [1.0, 2.5, 4.0]
-    pieces, dev = fit_curve(curve, [0.0, 2 * np.pi], tol, nodes=nodes)
+    pieces, dev = fit_arc_spline(curve, [0.0, 2 * np.pi], tol, nodes=nodes)
     assert dev.max() <= tol
     for phi in nodes:  # an arc ends at each node, within the band abeam C(φ)
         i = int(np.flatnonzero(pieces.hi == phi)[0])
@@ -197,3 +204,30 @@ def test_soft_nodes_end_an_arc_in_the_band_of_one_closed_interval():
     assert_allclose(starts[0], [0.0, 1.0], atol=1e-9)
     assert_allclose(ends[-1], [0.0, 1.0], atol=1e-9)
     assert_allclose(pieces.end[-1, 1], pieces.start[0, 0], atol=1e-9)
+
+
+def test_a_stalled_arc_search_raises_its_own_error():
+    # 1e-7 mm is below what the sampled screen and the measurement can separate
+    with pytest.raises(ArcSearchStallError, match="stalled"):
+        search_arcs(ellipse(60.0, 35.0), 0.0, 0.5, 1e-7)
+
+
+def test_a_stalled_search_falls_back_to_the_biarc_march_within_tolerance(monkeypatch):
+    def stall(*args, **kwargs):
+        raise ArcSearchStallError("arc search stalled")
+
+    monkeypatch.setattr(spline, "search_arcs", stall)
+    curve, tol = wobble(), 0.004
+    pieces, dev = fit_arc_spline(curve, np.linspace(0.0, 2 * np.pi, 5), tol)
+    assert dev.max() <= tol
+    assert_two_way_within(curve, pieces, tol)
+    assert_allclose(pieces.end[:-1, 1], pieces.start[1:, 0], atol=0)  # still one connected path
+
+
+def test_other_errors_of_the_search_are_not_taken_for_a_stall(monkeypatch):
+    def broken(*args, **kwargs):
+        raise ValueError("not a stall")
+
+    monkeypatch.setattr(spline, "search_arcs", broken)
+    with pytest.raises(ValueError, match="not a stall"):
+        fit_arc_spline(wobble(), np.linspace(0.0, 2 * np.pi, 5), 0.004)

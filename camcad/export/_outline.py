@@ -1,4 +1,4 @@
-"""Shared 2-D contour code for the exporters: bore outline, curve flattening, areas.
+"""Plane outlines for the exporters: bore outline, curve flattening, areas.
 
 Conventions: points are (n, 2) arrays in the cam frame [mm]; a closed polygon
 does not repeat its first point; positive signed area means counter-clockwise.

@@ -1,7 +1,7 @@
 """Plan the toolpath that mills a cam plate's outside profile (and its bore) from stock.
 
 The tool-centre path is the exact profile offset outward by the tool radius,
-``cam.offset(phi, r_tool)``, approximated by biarcs within the tolerance.
+``cam.offset(phi, r_tool)``, approximated by arc splines within the tolerance.
 Roughing passes step down to the full depth on the path offset by the tool
 radius plus the stock to leave; one full-depth finishing pass follows. Passes
 enter and leave on tangent arcs off the part, may leave holding tabs, and
@@ -22,20 +22,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from camcad._typing import FloatArray
-from camcad.angles import flagged_ranges, format_ranges
-from camcad.design import Direction, GcodeSpec
-from camcad.errors import DesignError, DesignLimitError, GougeError
-from camcad.export.gcode._contour import LINE_SAGITTA, Contour, fit_contour, round_mm
-from camcad.export.gcode._passes import Program, check_bore, cut_contour, lead_points, mill_bore
-from camcad.export.gcode.moves import Move, MoveKind, path_length
+from camcad.errors import DesignError, DesignLimitError
 from camcad.geometry.cam import Cam
+from camcad.geometry.tool import check_tool
+from camcad.toolpath.contour import LINE_SAGITTA, Contour, fit_contour, round_mm
+from camcad.toolpath.moves import Move, MoveKind, path_length
+from camcad.toolpath.passes import Program, check_bore, cut_contour, lead_points, mill_bore
+from camcad.toolpath.spec import Direction, GcodeSpec
 
-__all__ = ["RAPID_RATE", "Toolpath", "check_gouge", "plan_toolpath"]
+__all__ = ["RAPID_RATE", "Toolpath", "plan_toolpath"]
 
 TWO_PI = 2.0 * math.pi
 RAPID_RATE = 5000.0  # mm/min, assumed for the cycle-time estimate
@@ -109,40 +108,6 @@ class Toolpath:
             rate = rapid_rate if m.kind is MoveKind.RAPID else m.feed
             minutes += m.length / rate
         return 60.0 * minutes
-
-    def summary(self) -> dict[str, Any]:
-        """Figures for summary.json: blocks, arcs, cutting length [mm], cycle time [s], deviation [mm]."""
-        from camcad.export.gcode.writer import render_gcode, summarize
-
-        return summarize(self, render_gcode(self)).as_dict()
-
-
-def check_gouge(cam: Cam, tool_radius: float) -> float:
-    """Smallest concave profile radius [mm] (inf if none); raise if the tool does not fit.
-
-    Raises
-    ------
-    GougeError
-        Where a concave radius of the profile is smaller than ``tool_radius``:
-        the message names the cam-angle ranges in degrees and the largest tool
-        diameter that fits (twice the smallest concave radius).
-    """
-    phi = cam.sample_phi()
-    rho = cam.profile(phi).rho
-    concave = rho < 0.0
-    smallest = float(np.min(-rho[concave])) if concave.any() else math.inf
-    bad = concave & (-rho < tool_radius)
-    if bad.any():
-        ranges = flagged_ranges(phi, bad)
-        raise GougeError(
-            f"tool Ø{2 * tool_radius:g} mm gouges the profile at φ = {format_ranges(ranges)}: "
-            f"its concave radius is down to {smallest:.3f} mm, below the tool radius "
-            f"{tool_radius:g} mm; the largest tool that fits is Ø{2 * smallest:.3f} mm "
-            "(set gcode.tool_diameter below it)",
-            phi_range=ranges[0],
-            max_tool_radius=smallest,
-        )
-    return smallest
 
 
 def _check_corners(cam: Cam) -> None:
@@ -286,45 +251,16 @@ def plan_toolpath(
     Tab width is the bridge left on the part; the tool rises over
     ``tab_width + tool diameter`` of its path, measured on the finishing path.
     """
-    r = spec.tool_radius
-    tol = spec.tolerance
-    fit_tol = _fit_tolerance(tol)
+    fit_tol = _fit_tolerance(spec.tolerance)
     _check_corners(cam)
     if spec.mill_bore:
         check_bore(spec, bore)
-    concave = check_gouge(cam, r)
+    concave = check_tool(cam, spec.tool_radius)
+    tab_top = _tab_top(spec, thickness)
+    notes: list[str] = []
+    stock = _roughing_stock(spec, concave, notes)
+    finish, rough, lead = _fit_contours(cam, spec, stock, fit_tol, arcs=arcs, notes=notes)
     depth = thickness + spec.breakthrough
-    tab_top = None
-    if spec.tab_count > 0:
-        if spec.tab_height >= thickness:
-            raise DesignError(
-                "gcode.tab_height",
-                f"{spec.tab_height:g} mm must be below the plate thickness {thickness:g} mm",
-            )
-        tab_top = round_mm(-thickness + spec.tab_height)
-    stock = spec.stock_to_leave
-    notes = []
-    if math.isfinite(concave) and r + stock >= 0.9 * concave:
-        stock = max(0.0, 0.9 * concave - r)
-        notes.append(f"roughing stock reduced to {stock:.3f} mm by a concave radius of {concave:.3f} mm")
-    phi0 = float(spec.start_angle) % TWO_PI
-    windows = _tab_windows(cam, spec, phi0)
-    breaks = _breaks(cam, phi0)
-    clockwise = spec.direction is Direction.CLIMB
-    finish = fit_contour(cam, r, breaks, tol, fit_tol, clockwise=clockwise, windows=windows, arcs=arcs)
-    if stock > 0.0:
-        rough = fit_contour(
-            cam, r + stock, breaks, tol, fit_tol,
-            clockwise=clockwise, windows=windows, arcs=arcs,
-        )  # fmt: skip
-    else:
-        rough = finish
-    wanted = spec.lead_radius if spec.lead_radius is not None else spec.tool_diameter
-    lead = _lead_radius(cam, finish, r, wanted, tol, phi0)
-    if rough is not finish:
-        lead = min(lead, _lead_radius(cam, rough, r + stock, lead, tol, phi0))
-    if lead < wanted:
-        notes.append(f"lead radius reduced to {lead:.3f} mm to stay clear of the part")
     n_levels = max(1, math.ceil(depth / spec.step_down - 1e-9))
     levels = tuple(round_mm(-depth * k / n_levels) for k in range(1, n_levels + 1))
     prog = Program(spec.clearance_height)
@@ -333,6 +269,7 @@ def plan_toolpath(
         prog.rapid(z=spec.clearance_height)
     elif bore > 0.0:
         notes.append(f"bore D{bore:g} not milled (gcode.mill_bore = false)")
+    r = spec.tool_radius
     for k, z in enumerate(levels, start=1):
         cut_contour(
             prog, rough, spec, z, tab_top, lead,
@@ -357,3 +294,60 @@ def plan_toolpath(
         contour_blocks=len(finish.steps),
         notes=tuple(notes),
     )
+
+
+def _tab_top(spec: GcodeSpec, thickness: float) -> float | None:
+    """Z of the top of the tabs [mm], or None without tabs.
+
+    Raises
+    ------
+    DesignError
+        When the tabs would reach the top of the plate (``gcode.tab_height``).
+    """
+    if spec.tab_count == 0:
+        return None
+    if spec.tab_height >= thickness:
+        raise DesignError(
+            "gcode.tab_height",
+            f"{spec.tab_height:g} mm must be below the plate thickness {thickness:g} mm",
+        )
+    return round_mm(-thickness + spec.tab_height)
+
+
+def _roughing_stock(spec: GcodeSpec, concave: float, notes: list[str]) -> float:
+    """Stock left by the roughing passes [mm], reduced so that the roughing path never loops.
+
+    Where the smallest concave radius ``concave`` [mm] is below 1/0.9 × (tool
+    radius + stock), the stock shrinks to 0.9 × concave − tool radius (a note says so).
+    """
+    r, stock = spec.tool_radius, spec.stock_to_leave
+    if math.isfinite(concave) and r + stock >= 0.9 * concave:
+        stock = max(0.0, 0.9 * concave - r)
+        notes.append(f"roughing stock reduced to {stock:.3f} mm by a concave radius of {concave:.3f} mm")
+    return stock
+
+
+def _fit_contours(
+    cam: Cam, spec: GcodeSpec, stock: float, fit_tol: float, *, arcs: bool, notes: list[str]
+) -> tuple[Contour, Contour, float]:
+    """The finishing and roughing contours and the lead radius [mm] that keeps both leads off the part."""
+    r, tol = spec.tool_radius, spec.tolerance
+    phi0 = float(spec.start_angle) % TWO_PI
+    windows = _tab_windows(cam, spec, phi0)
+    breaks = _breaks(cam, phi0)
+    clockwise = spec.direction is Direction.CLIMB
+    finish = fit_contour(cam, r, breaks, tol, fit_tol, clockwise=clockwise, windows=windows, arcs=arcs)
+    if stock > 0.0:
+        rough = fit_contour(
+            cam, r + stock, breaks, tol, fit_tol,
+            clockwise=clockwise, windows=windows, arcs=arcs,
+        )  # fmt: skip
+    else:
+        rough = finish
+    wanted = spec.lead_radius if spec.lead_radius is not None else spec.tool_diameter
+    lead = _lead_radius(cam, finish, r, wanted, tol, phi0)
+    if rough is not finish:
+        lead = min(lead, _lead_radius(cam, rough, r + stock, lead, tol, phi0))
+    if lead < wanted:
+        notes.append(f"lead radius reduced to {lead:.3f} mm to stay clear of the part")
+    return finish, rough, lead

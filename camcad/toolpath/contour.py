@@ -1,6 +1,6 @@
 """One closed contour of the toolpath: fitted, oriented for the milling direction, rounded.
 
-The biarcs of :mod:`camcad.export.gcode.biarc` are put in travel order, their
+The arc splines of :mod:`camcad.toolpath.arcs` are put in travel order, their
 end points rounded to 4 decimals, and each arc's I/J taken from its rounded
 start point, so that a controller's radius check (start and end radius within
 0.001 mm) passes. The deviation is then measured again on what is written.
@@ -16,12 +16,22 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.errors import DesignLimitError
-from camcad.export.gcode.arcspline import fit_curve
-from camcad.export.gcode.biarc import CurveFn, Pieces, measure_deviation
-from camcad.export.gcode.moves import MoveKind
 from camcad.geometry.cam import Cam
+from camcad.toolpath.arcs.biarc import CurveFn, Pieces, measure_deviation
+from camcad.toolpath.arcs.spline import fit_arc_spline
+from camcad.toolpath.moves import MoveKind
 
-__all__ = ["DECIMALS", "Contour", "fit_contour", "offset_curve", "round_mm", "round_point"]
+__all__ = [
+    "DECIMALS",
+    "LINE_SAGITTA",
+    "Contour",
+    "Step",
+    "fit_contour",
+    "offset_curve",
+    "round_mm",
+    "round_point",
+    "split_tabs",
+]
 
 DECIMALS = 4
 LINE_SAGITTA = 0.05  # × tolerance: an arc bulging less is written as G1
@@ -170,7 +180,7 @@ def _project(st: Step, q: FloatArray) -> tuple[float, float, float]:
     return float(np.linalg.norm(q - p)), float(p[0]), float(p[1])
 
 
-def _split_tabs(steps: list[Step], edges: FloatArray) -> list[Step]:
+def split_tabs(steps: list[Step], edges: FloatArray) -> list[Step]:
     """Split steps at the tab edges (points (m, 2) on the path) and flag the steps over tabs.
 
     The path starts outside every tab, so the flag flips at each edge met.
@@ -245,7 +255,7 @@ def fit_contour(
     curve = offset_curve(cam, distance)
     try:
         edges = [a for w in windows for a in w]
-        pieces, _ = fit_curve(curve, breaks, fit_tol, arcs=arcs, nodes=edges)
+        pieces, _ = fit_arc_spline(curve, breaks, fit_tol, arcs=arcs, nodes=edges)
     except ValueError as err:  # pragma: no cover - only for a cusp the gouge check missed
         raise DesignLimitError(f"cannot fit the toolpath: {err}") from err
     reverse = (_signed_area(pieces) > 0.0) == clockwise
@@ -256,7 +266,7 @@ def fit_contour(
     steps = _merge(steps)
     if windows:
         edge_phi = np.asarray([a for w in windows for a in w])
-        steps = _split_tabs(steps, np.asarray(curve(edge_phi)[0]))
+        steps = split_tabs(steps, np.asarray(curve(edge_phi)[0]))
     ends = np.array([breaks[0], breaks[-1]])
     o = cam.offset(ends, distance)
     sign = -1.0 if reverse else 1.0

@@ -1,0 +1,241 @@
+"""The toolpath planner: passes, leads, tabs, bore, limits; every program is proved against the exact cam.
+
+The proof (:func:`check_toolpath`) runs on the program as written and read
+back by the G-code reader, and measures it against ``cam.offset(φ, r)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from functools import cache
+
+import numpy as np
+import pytest
+
+from camcad.design import Design, load_design
+from camcad.errors import DesignError, DesignLimitError, GougeError
+from camcad.export.gcode import parse_gcode, render_gcode
+from camcad.geometry.cam import Cam
+from camcad.geometry.tool import check_tool
+from camcad.toolpath import MoveKind, Toolpath, check_toolpath, plan_toolpath
+from camcad.toolpath.contour import Step, split_tabs
+from tests.conftest import SAMPLES, make_design
+
+CONFIGS = {
+    "climb": {},
+    "conventional": {"direction": "conventional"},
+    "tabs-bore-coolant": {"tab_count": 3, "mill_bore": True, "coolant": True},
+    "start-75-no-stock": {"start_angle": 75.0, "stock_to_leave": 0.0, "lead_radius": 4.0},
+    "grbl-tight": {"dialect": "grbl", "tolerance": 0.002, "tool_diameter": 8.0},
+}
+
+
+def design_for(config: str) -> Design:
+    if config == "flat":
+        return make_design(follower="translating-flat", law="harmonic", extra={"gcode": {"tab_count": 2}})
+    if config == "cw-offset":
+        return make_design(rotation="cw", offset=6.0, law="poly-345", extra={"cam": {"bore": 12.0}})
+    return make_design(extra={"cam": {"bore": 10.0}, "gcode": CONFIGS[config]})
+
+
+@cache
+def planned(config: str) -> tuple[Design, Cam, Toolpath]:
+    design = design_for(config)
+    cam = Cam.from_design(design)
+    tp = plan_toolpath(
+        cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
+    )
+    return design, cam, tp
+
+
+ALL = [*CONFIGS, "flat", "cw-offset"]
+
+
+@pytest.mark.parametrize("config", ALL)
+def test_parsed_program_passes_the_geometric_proof(config):
+    design, cam, tp = planned(config)
+    moves = parse_gcode(render_gcode(tp))
+    check = check_toolpath(moves, cam, design.gcode, thickness=design.cam.thickness, bore=design.cam.bore)
+    assert check.ok, check.problems
+    assert check.hausdorff <= design.gcode.tolerance
+    assert check.min_clearance >= -design.gcode.tolerance
+    assert check.max_radius_mismatch <= 1e-3
+    assert check.direction is design.gcode.direction
+    assert not check.missing_levels
+    assert check.low_rapids == 0
+
+
+def test_climb_runs_clockwise_and_conventional_counter_clockwise():
+    # outside profile, spindle M3: climb keeps the part on the tool's right, i.e. clockwise
+    for config, sign in (("climb", -1.0), ("conventional", 1.0)):
+        _, _, tp = planned(config)
+        finish = tp.moves[-60:]  # inside the finishing pass
+        area = sum(
+            m.start[0] * m.end[1] - m.end[0] * m.start[1] for m in finish if m.end[2] == tp.final_depth
+        )
+        assert np.sign(area) == sign
+
+
+def test_no_rapid_below_safe_height_and_plunges_are_off_the_part():
+    design, cam, tp = planned("tabs-bore-coolant")
+    spec = design.gcode
+    for i, m in enumerate(tp.moves):
+        if m.kind is MoveKind.RAPID:
+            assert m.end[2] >= spec.safe_height and (i == 0 or m.start[2] >= spec.safe_height)
+    plunges = [m for m in tp.moves if m.kind is MoveKind.LINE and m.end[2] < m.start[2] and m.start[2] > 0]
+    assert len(plunges) == len(tp.levels) + 2  # roughing levels, finishing, bore
+    for m in plunges[1:]:  # the first is the bore
+        radius = np.hypot(*m.end[:2])
+        assert radius > cam.base_radius
+
+
+def _pass_depths(moves):
+    """Lowest Z [mm] of every pass: the runs of feed moves between rapids."""
+    depths, run = [], []
+    for m in (*moves, None):
+        if m is None or m.kind is MoveKind.RAPID:
+            if run:
+                depths.append(min(run))
+            run = []
+        else:
+            run.append(m.end[2])
+    return depths
+
+
+@pytest.mark.parametrize("config", ["climb", "grbl-tight"])
+def test_every_step_down_level_is_cut(config):
+    # measured on the program as written and read back, against the design's own numbers: the
+    # profile is cut from the stock top (Z0) down to -(thickness + breakthrough) in equal steps of at
+    # most step_down, in the fewest passes that allows, and finished at the full depth
+    design, _, tp = planned(config)
+    spec = design.gcode
+    full = -(design.cam.thickness + spec.breakthrough)
+    depths = _pass_depths(parse_gcode(render_gcode(tp)))
+    *rough, finish = depths
+    assert finish == pytest.approx(full, abs=1e-4)
+    assert rough[-1] == pytest.approx(full, abs=1e-4)
+    steps = -np.diff([0.0, *rough])
+    assert np.all(steps <= spec.step_down + 1e-4)
+    assert np.ptp(steps) <= 2e-4  # equal steps, to the 4 decimals written
+    assert (len(rough) - 1) * spec.step_down < -full  # one pass fewer could not reach the depth
+
+
+def test_tabs_lift_the_tool_on_passes_below_tab_top():
+    design, _, tp = planned("tabs-bore-coolant")
+    assert tp.tab_top == pytest.approx(-design.cam.thickness + design.gcode.tab_height)
+    lifts = [
+        m for m in tp.moves if m.kind is MoveKind.LINE and m.end[2] == tp.tab_top and m.start[2] < tp.tab_top
+    ]
+    passes_below = sum(1 for z in tp.levels if z < tp.tab_top) + 1  # + finishing
+    assert len(lifts) == design.gcode.tab_count * passes_below
+
+
+def test_bore_is_helix_milled_inside_its_wall():
+    design, _, tp = planned("tabs-bore-coolant")
+    bore = [m for m in tp.moves if m.kind.is_arc and math.hypot(*m.end[:2]) < design.cam.bore / 2]
+    assert bore and all(m.kind is MoveKind.CCW for m in bore)  # climb inside a hole
+    reach = max(math.hypot(*m.end[:2]) for m in bore) + design.gcode.tool_radius
+    assert reach == pytest.approx(design.cam.bore / 2.0, abs=1e-4)
+    assert min(m.end[2] for m in bore) == pytest.approx(tp.final_depth)
+
+
+def test_bore_not_larger_than_tool_is_an_error_naming_sizes():
+    design = make_design(extra={"cam": {"bore": 6.0}, "gcode": {"mill_bore": True, "tool_diameter": 6.0}})
+    cam = Cam.from_design(design)
+    with pytest.raises(DesignError, match=r"bore Ø6 mm is not larger than the tool Ø6 mm"):
+        plan_toolpath(cam, design.gcode, name="x", thickness=8.0, bore=6.0)
+    with pytest.raises(DesignError, match="no bore"):
+        plan_toolpath(cam, design.gcode, name="x", thickness=8.0, bore=0.0)
+
+
+CONCAVE = {"spans": (45.0, 135.0, 45.0, 135.0), "lift": 25.0, "base_radius": 20.0, "roller_radius": 8.0}
+
+
+def test_tool_larger_than_concave_radius_stops_the_plan_with_a_gouge_error():
+    design = make_design(**CONCAVE, extra={"gcode": {"tool_diameter": 30.0}})
+    cam = Cam.from_design(design)
+    with pytest.raises(GougeError, match=r"set gcode\.tool_diameter below it") as err:
+        plan_toolpath(cam, design.gcode, name="x", thickness=8.0)
+    assert err.value.max_tool_radius == pytest.approx(check_tool(cam, 1.0))
+
+
+def test_largest_fitting_tool_mills_the_concave_cam_without_gouging():
+    design = make_design(**CONCAVE)
+    cam = Cam.from_design(design)
+    tool = 2 * 0.95 * check_tool(cam, 1.0)
+    spec = replace(design.gcode, tool_diameter=round(tool, 2))
+    tp = plan_toolpath(cam, spec, name="x", thickness=8.0)
+    check = check_toolpath(parse_gcode(render_gcode(tp)), cam, spec, thickness=8.0)
+    assert check.ok, check.problems
+    assert tp.rough_offset < spec.tool_radius + spec.stock_to_leave  # stock reduced in the concave part
+    assert any("stock reduced" in note for note in tp.notes)
+    assert any("lead radius reduced" in note for note in tp.notes)
+
+
+def test_bad_settings_are_design_errors():
+    design, cam, _ = planned("climb")
+    with pytest.raises(DesignError, match=r"gcode\.tolerance"):
+        plan_toolpath(cam, replace(design.gcode, tolerance=0.0003), name="x", thickness=8.0)
+    with pytest.raises(DesignError, match=r"gcode\.tab_height"):
+        plan_toolpath(cam, replace(design.gcode, tab_count=2, tab_height=8.0), name="x", thickness=8.0)
+    with pytest.raises(DesignError, match=r"gcode\.tab_width"):
+        plan_toolpath(cam, replace(design.gcode, tab_count=40, tab_width=10.0), name="x", thickness=8.0)
+
+
+def test_velocity_jump_is_refused():
+    design = make_design(law="constant-velocity")
+    with pytest.raises(DesignLimitError, match="velocity jumps"):
+        plan_toolpath(Cam.from_design(design), design.gcode, name="x", thickness=8.0)
+
+
+def test_g1_only_path_meets_the_same_tolerance_with_many_more_blocks():
+    design, cam, tp = planned("climb")
+    lines = plan_toolpath(cam, design.gcode, name="x", thickness=8.0, arcs=False)
+    arcs = sum(1 for m in lines.moves if m.kind.is_arc)
+    assert arcs == 2 * (len(lines.levels) + 1)  # only the tangent leads
+    assert lines.max_deviation <= design.gcode.tolerance
+    check = check_toolpath(parse_gcode(render_gcode(lines)), cam, design.gcode, thickness=8.0)
+    assert check.ok, check.problems
+    assert lines.contour_blocks > 5 * tp.contour_blocks
+
+
+@pytest.mark.parametrize("path", SAMPLES[:2], ids=[p.stem for p in SAMPLES[:2]])
+def test_samples_plan_and_prove(path):
+    design = load_design(path)
+    cam = Cam.from_design(design)
+    tp = plan_toolpath(
+        cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
+    )
+    check = check_toolpath(
+        parse_gcode(render_gcode(tp)), cam, design.gcode, thickness=design.cam.thickness, bore=design.cam.bore
+    )
+    assert check.ok, check.problems
+
+
+def test_tool_nearly_filling_the_bore_gets_a_bounded_helix():
+    design = make_design(extra={"cam": {"bore": 10.2}, "gcode": {"mill_bore": True, "tool_diameter": 10.0}})
+    cam = Cam.from_design(design)
+    tp = plan_toolpath(cam, design.gcode, name="x", thickness=8.0, bore=10.2)
+    helix = [m for m in tp.moves if m.kind.is_arc and math.hypot(*m.end[:2]) < 5.1]
+    assert 5 <= len(helix) <= 12
+    check = check_toolpath(parse_gcode(render_gcode(tp)), cam, design.gcode, thickness=8.0, bore=10.2)
+    assert check.ok, check.problems
+    assert check.bore_excess <= design.gcode.tolerance
+
+
+def test_tab_edges_split_steps_and_flag_the_span_between():
+    line = MoveKind.LINE
+    steps = [
+        Step(kind=line, start=(0.0, 0.0), end=(10.0, 0.0)),
+        Step(kind=line, start=(10.0, 0.0), end=(20.0, 0.0)),
+        Step(kind=line, start=(20.0, 0.0), end=(30.0, 0.0)),
+    ]
+    # one edge inside the first step, one exactly at the end of the second
+    out = split_tabs(steps, np.array([[4.0, 0.001], [20.0, 0.0]]))
+    assert [(s.start[0], s.end[0], s.tab) for s in out] == [
+        (0.0, 4.0, False),
+        (4.0, 10.0, True),
+        (10.0, 20.0, True),
+        (20.0, 30.0, False),
+    ]
