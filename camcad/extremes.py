@@ -61,6 +61,7 @@ SIDE_WORDS = {"left": "before joint", "right": "after joint"}
 """How summary.json names a one-sided limit (the ``*_side`` keys)."""
 
 _GOLDEN_SECTION = (3.0 - math.sqrt(5.0)) / 2.0  # 0.382: the golden step into the larger side
+_ROUNDOFF = 1e-12  # relative: a refined value must beat the samples by more than this
 _CONTINUOUS_RTOL = 1e-9  # one-sided limits this close are one value: no "just before the joint"
 _ITERATIONS = 60  # at most; a golden step alone shrinks a bracket by 0.618 (0.618^60 ≈ 3e-13)
 _XTOL = 1e-11  # rad: the smallest step the search takes
@@ -380,7 +381,8 @@ def extremes_rows(
             mine = np.flatnonzero(br.row == r)
             if mine.size:
                 i = mine[int(np.argmax(f_best[mine]))]
-                if f_best[i] > best[r]:
+                # a gain within round-off (a flat stretch, say a dwell) keeps the sample
+                if f_best[i] > best[r] + _ROUNDOFF * max(1.0, abs(best[r])):
                     found[r] = Extreme(value=float(sign[r, 0] * f_best[i]), phi=float(phi_best[i]), side=None)
     return tuple(found)
 
