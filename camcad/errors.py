@@ -28,7 +28,6 @@ __all__ = [
     "FitError",
     "GcodeSyntaxError",
     "GougeError",
-    "JumpError",
     "NotStarShapedError",
     "OutputError",
     "UndercutError",
@@ -155,10 +154,6 @@ class GougeError(DesignLimitError):
         super().__init__(message)
         self.phi_range = phi_range
         self.max_tool_radius = max_tool_radius
-
-
-class JumpError(DesignLimitError):
-    """The follower leaves the cam (contact force below the margin)."""
 
 
 class FitError(DesignLimitError):

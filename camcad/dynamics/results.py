@@ -16,7 +16,6 @@ import numpy as np
 from camcad._typing import FloatArray
 from camcad.dynamics.jump import covering_arc
 from camcad.dynamics.spec import DynamicsModel
-from camcad.errors import JumpError
 from camcad.extremes import SIDE_WORDS, Extreme
 from camcad.findings import Finding
 
@@ -179,16 +178,3 @@ class DynamicsResult:
         for angle, force, torque, stress in self.table():
             rows.append((f"{angle:.6f}", f"{force:.6f}", f"{torque:.6f}", f"{stress:.6f}"))
         return rows
-
-    def raise_if_jump(self) -> None:
-        """Raise :class:`~camcad.errors.JumpError` if the follower leaves the cam.
-
-        Raises
-        ------
-        JumpError
-            With the first jump warning as its message.
-        """
-        if not self.jump:
-            return
-        message = next((w for w in self.warnings if "jump" in w or "below" in w), None)
-        raise JumpError(message or "the follower leaves the cam")

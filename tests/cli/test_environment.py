@@ -280,7 +280,7 @@ def test_exit_codes_are_defined_once_on_the_error_classes():
     assert errors.exit_code(errors.DesignError("x", "y")) == errors.EXIT_INVALID == 2
     assert errors.exit_code(errors.UsageError("--only", "y")) == 2
     assert errors.exit_code(OutputError("out", "full")) == 2
-    assert errors.exit_code(errors.JumpError("j")) == errors.EXIT_LIMIT == 3
+    assert errors.exit_code(errors.DesignLimitError("j")) == errors.EXIT_LIMIT == 3
     assert errors.exit_code(errors.NotStarShapedError("s")) == 3
     assert errors.exit_code(errors.FitError("f", best_error=1.0, control_points=3)) == 3
     assert errors.exit_code(errors.ExportError("e")) == errors.EXIT_UNEXPECTED == 1
