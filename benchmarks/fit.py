@@ -92,7 +92,8 @@ def reference_002(n_ctrl: int = 80) -> str:
     return (
         f"002 reference (offset-roller sample, {len(phi)} samples): {n_ctrl} control points, "
         f"uniform knots: max error {err * 1e3:.3f} µm (002: 58.7 µm with 90 data points); "
-        f"camcad at {TOL * 1e3:g} µm: {ours.control_points} control points, {ours.max_error * 1e3:.3f} µm"
+        f"camcad at {TOL * 1e3:g} µm: {ours.control_point_count} control points, "
+        f"{ours.max_error * 1e3:.3f} µm"
     )
 
 
@@ -206,14 +207,14 @@ def main() -> None:
         p = fit.degree
         tau = fit.curve.knots[p : -p - 1]
         ours = lsq_time(phi, points, tau)
-        g_err, g_time = geomdl_error(phi, points, exact, fit.control_points)
+        g_err, g_time = geomdl_error(phi, points, exact, fit.control_point_count)
         count = "—"
         if name.endswith("roller cam") and budget > 0:
             t0 = time.perf_counter()
-            count = geomdl_count(phi, points, exact, fit.control_points, budget / 2)
+            count = geomdl_count(phi, points, exact, fit.control_point_count, budget / 2)
             budget -= time.perf_counter() - t0
         print(
-            f"| {name} | {len(phi)} | {fit.control_points} | {fit.max_error * 1e3:.3f} "
+            f"| {name} | {len(phi)} | {fit.control_point_count} | {fit.max_error * 1e3:.3f} "
             f"| {t_min * 1e3:.1f} / {t_med * 1e3:.1f} | {ours * 1e3:.2f} | {g_time * 1e3:.0f} "
             f"| {g_time / ours:.0f}× | {g_err * 1e3:.1f} | {count} |"
         )
@@ -228,7 +229,7 @@ def main() -> None:
         points = exact(phi)
         fit, t_min, t_med = fit_timed(phi, points, exact, breaks)
         print(
-            f"| {n} | {fit.control_points} | {fit.max_error * 1e3:.3f} "
+            f"| {n} | {fit.control_point_count} | {fit.max_error * 1e3:.3f} "
             f"| {t_min * 1e3:.1f} / {t_med * 1e3:.1f} | {t_min / n * 1e6:.2f} |"
         )
 

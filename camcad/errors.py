@@ -159,10 +159,10 @@ class GougeError(DesignLimitError):
 class FitError(DesignLimitError):
     """The NURBS fit cannot meet the tolerance within the control-point budget (a hard limit)."""
 
-    def __init__(self, message: str, *, best_error: float, control_points: int) -> None:
+    def __init__(self, message: str, *, best_error: float, control_point_count: int) -> None:
         super().__init__(message)
         self.best_error = best_error
-        self.control_points = control_points
+        self.control_point_count = control_point_count
 
     exit_code = EXIT_LIMIT
 

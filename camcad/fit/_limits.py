@@ -89,24 +89,24 @@ def limit_error(
             f"{names.tolerance}: {tolerance:.3g} mm is out of reach: {n_samples} samples leave room for "
             f"at most {reached} control points ({at_best}); relax {names.tolerance}"
         )
-        return SamplesTooFewError(message, best_error=best_error, control_points=cps)
+        return SamplesTooFewError(message, best_error=best_error, control_point_count=cps)
     if samples_bind:
         message = (
             f"{names.samples}: {n_samples} samples leave room for at most {reached} control points, too "
             f"few for {tol} ({at_best}); sample more finely ({names.samples}) or relax {names.tolerance}"
         )
-        return SamplesTooFewError(message, best_error=best_error, control_points=cps)
+        return SamplesTooFewError(message, best_error=best_error, control_point_count=cps)
     if automatic_budget:
         message = (
             f"{names.tolerance}: {tolerance:.3g} mm is out of reach: the search reached {reached} control "
             f"points (the automatic limit, {max_control_points}), {at_best}; relax {names.tolerance} "
             f"(or set {names.max_control_points} higher if memory allows)"
         )
-        return FitError(message, best_error=best_error, control_points=cps)
+        return FitError(message, best_error=best_error, control_point_count=cps)
     need = "" if needed is None else f" (about {needed} needed)"
     message = (
         f"{names.max_control_points}: {max_control_points} control points are too few for {tol}: the "
         f"search reached {reached}, {at_best}; raise {names.max_control_points}{need}, leave it out "
         f"(automatic) or relax {names.tolerance}"
     )
-    return FitError(message, best_error=best_error, control_points=cps)
+    return FitError(message, best_error=best_error, control_point_count=cps)

@@ -112,7 +112,7 @@ class _Problem:
     def periodic(self) -> bool:
         return self.fixed.periodic
 
-    def control_points(self, n_free: int) -> int:
+    def control_point_count(self, n_free: int) -> int:
         """Control points of the clamped form for ``n_free`` free knots (at most).
 
         A closed curve opened at a knot of multiplicity μ has
@@ -129,7 +129,7 @@ class _Problem:
         """Smallest and largest admissible free-knot counts."""
         p = self.degree
         lo = max(0, p + 1 - self.fixed.n_fixed) if self.periodic else 0
-        return lo, min(self.max_control_points - self.control_points(0), self.room())
+        return lo, min(self.max_control_points - self.control_point_count(0), self.room())
 
     def room(self) -> int:
         """Free knots the samples allow (``MIN_SAMPLE_GAP`` samples between neighbours)."""
@@ -295,16 +295,16 @@ def _unreachable(search: _Search) -> FitError:
     needed = None
     if best is not None and math.isfinite(err):
         est = estimate_free_knots(best, prob.fixed.n_segments, err, prob.tolerance, prob.degree)
-        needed = prob.control_points(est)
+        needed = prob.control_point_count(est)
     return limit_error(
         names=prob.names,
         tolerance=prob.tolerance,
         n_samples=len(prob.points),
         max_control_points=prob.max_control_points,
         automatic_budget=prob.automatic_budget,
-        samples_bind=search.coarse.room() < prob.max_control_points - prob.control_points(0),
-        reached=prob.control_points(max(search.trials, default=0)),
-        best=None if best is None else prob.control_points(best),
+        samples_bind=search.coarse.room() < prob.max_control_points - prob.control_point_count(0),
+        reached=prob.control_point_count(max(search.trials, default=0)),
+        best=None if best is None else prob.control_point_count(best),
         best_error=err,
         needed=needed,
     )
@@ -345,7 +345,7 @@ def _search(problem: _Problem) -> tuple[BSplineCurve, tuple[Certificate, Certifi
     again on a subsample four times larger (at last on all samples).
     """
     size = max(SEARCH_SAMPLES, SEARCH_SAMPLES_PER_SEGMENT * problem.fixed.n_segments)
-    budget = problem.max_control_points - problem.control_points(0)
+    budget = problem.max_control_points - problem.control_point_count(0)
     while True:
         search = _Search(problem, _subsample(problem, size))
         try:
@@ -401,7 +401,7 @@ def _result(
         tolerance=problem.tolerance,
         max_error=_certified_max(certs),
         rms_error=at_samples.rms_error,
-        control_points=len(clamped.control_points),
+        control_point_count=len(clamped.control_points),
         degree=problem.degree,
         seam_tangent_jump=tangent_jump,
         seam_curvature_jump=curvature_jump,

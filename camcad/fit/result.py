@@ -64,7 +64,7 @@ class ProfileFit:
     tolerance: float
     max_error: float
     rms_error: float
-    control_points: int
+    control_point_count: int
     degree: int
     seam_tangent_jump: float
     seam_curvature_jump: float
@@ -91,6 +91,6 @@ class ProfileFit:
             "tolerance_mm": self.tolerance,
             "max_error_mm": self.max_error,
             "rms_error_mm": self.rms_error,
-            "control_points": self.control_points,
+            "control_points": self.control_point_count,
             "degree": self.degree,
         }

@@ -282,7 +282,7 @@ def test_exit_codes_are_defined_once_on_the_error_classes():
     assert errors.exit_code(OutputError("out", "full")) == 2
     assert errors.exit_code(errors.DesignLimitError("j")) == errors.EXIT_LIMIT == 3
     assert errors.exit_code(errors.NotStarShapedError("s")) == 3
-    assert errors.exit_code(errors.FitError("f", best_error=1.0, control_points=3)) == 3
+    assert errors.exit_code(errors.FitError("f", best_error=1.0, control_point_count=3)) == 3
     assert errors.exit_code(errors.ExportError("e")) == errors.EXIT_UNEXPECTED == 1
     assert errors.exit_code(PermissionError(13, "denied")) == 2
     assert errors.exit_code(KeyboardInterrupt()) == errors.EXIT_INTERRUPTED == 130

@@ -185,7 +185,7 @@ def test_128_segment_program_fits_at_1_um_with_the_default_budget():
     cam = Cam.from_design(design)
     assert len(cam.program.breakpoints) == 128
     fit = fit_cam_profile(cam, tolerance=1e-3, max_control_points=design.fit.max_control_points)
-    assert fit.control_points > 500  # the old fixed default could not hold it
+    assert fit.control_point_count > 500  # the old fixed default could not hold it
     assert fit.max_error <= 1e-3
     phi = np.linspace(0.0, 2 * np.pi, 200_000, endpoint=False)
     assert dense_distance(fit.curve, np.asarray(cam.profile(phi).point)).max() <= fit.max_error
@@ -195,7 +195,7 @@ def test_default_budget_is_not_capped_by_the_search_subsample():
     # 5 nm needs about 600 control points: more than the 1200-sample search subsample leaves room for
     cam = sample_cam("offset_roller")
     fit = fit_cam_profile(cam, tolerance=5e-9)
-    assert fit.control_points > 550
+    assert fit.control_point_count > 550
     assert fit.max_error <= 5e-9
     assert dense_distance(fit.curve, dense_profile("offset_roller", 200_000)).max() <= fit.max_error
 
@@ -208,7 +208,7 @@ def test_fit_error_names_the_budget_and_the_count_reached():
         "fit.max_control_points: 20 control points are too few for fit.tolerance = 0.001 mm"
     )
     assert "reached 20" in message
-    assert info.value.control_points <= 20
+    assert info.value.control_point_count <= 20
     assert info.value.best_error > 1e-3
 
 
