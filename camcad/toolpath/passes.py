@@ -31,6 +31,7 @@ class Program:
         self.note = ""
 
     def comment(self, text: str) -> None:
+        """Attach ``text`` to the next move as its comment."""
         self.note = text if not self.note else f"{self.note}\n{text}"
 
     def _add(self, kind: MoveKind, end: tuple[float, float, float], **kw: Any) -> None:
@@ -41,12 +42,14 @@ class Program:
         self.pos = end
 
     def rapid(self, x: float | None = None, y: float | None = None, z: float | None = None) -> None:
+        """Rapid move to (x, y, z) [mm]; an axis left out keeps its position."""
         px, py, pz = self.pos
         self._add(MoveKind.RAPID, (px if x is None else x, py if y is None else y, pz if z is None else z))
 
     def line(
         self, x: float | None = None, y: float | None = None, z: float | None = None, *, feed: float
     ) -> None:
+        """Straight feed move to (x, y, z) [mm] at ``feed`` [mm/min]; an axis left out keeps its position."""
         px, py, pz = self.pos
         end = (px if x is None else x, py if y is None else y, pz if z is None else round_mm(z))
         self._add(MoveKind.LINE, end, feed=feed)
@@ -55,6 +58,7 @@ class Program:
         self, kind: MoveKind, x: float, y: float, center: tuple[float, float], *,
         feed: float, z: float | None = None,
     ) -> None:  # fmt: skip
+        """Arc move of ``kind`` (CW or CCW) to (x, y) about ``center`` [mm], optionally helical to z."""
         end = (x, y, self.pos[2] if z is None else round_mm(z))
         self._add(kind, end, center=center, feed=feed)
 

@@ -27,7 +27,7 @@ class TranslatingRoller:
 
     @property
     def prime_k(self) -> float:
-        """k [mm]: roller-centre height at s = 0."""
+        """Roller-centre height k [mm] at s = 0."""
         return math.sqrt((self.base_radius + self.roller_radius) ** 2 - self.eccentricity**2)
 
     @property
