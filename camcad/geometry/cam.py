@@ -9,8 +9,9 @@ contact element (:mod:`camcad.geometry.followers`) and the generic envelope
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.geometry.curves import CurveSample
@@ -26,11 +27,47 @@ from camcad.geometry.envelope import (
 from camcad.geometry.followers import Follower, TranslatingFlat, TranslatingRoller
 from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
 from camcad.motion.program import Motion, MotionProgram, Side
-
-if TYPE_CHECKING:  # the design schema sits above the stages; only its shape is used here
-    from camcad.design import Design
+from camcad.motion.segments import SegmentSpec
 
 __all__ = ["Cam", "CamState", "follower_from_spec"]
+
+
+class _CamTable(Protocol):
+    """What a cam is built from of the design's ``[cam]`` table."""
+
+    @property
+    def base_radius(self) -> float:
+        """r_b [mm]."""
+        ...
+
+    @property
+    def rotation(self) -> Rotation:
+        """The sense the cam turns."""
+        ...
+
+    @property
+    def sample_step(self) -> float:
+        """Sampling step [rad]."""
+        ...
+
+
+class _CamDesign(Protocol):
+    """The shape of a design that :meth:`Cam.from_design` reads (the schema sits above this stage)."""
+
+    @property
+    def cam(self) -> _CamTable:
+        """The ``[cam]`` table."""
+        ...
+
+    @property
+    def follower(self) -> FollowerSpec:
+        """The ``[follower]`` table."""
+        ...
+
+    @property
+    def motion(self) -> Sequence[SegmentSpec]:
+        """The ``[[motion]]`` segments."""
+        ...
 
 
 def follower_from_spec(spec: FollowerSpec, base_radius: float) -> Follower:
@@ -91,7 +128,7 @@ class Cam:
     sample_step: float = math.radians(0.1)
 
     @classmethod
-    def from_design(cls, design: Design) -> Cam:
+    def from_design(cls, design: _CamDesign) -> Cam:
         """The cam a validated design describes."""
         return cls(
             program=MotionProgram.from_segments(design.motion),
