@@ -4,10 +4,27 @@ from __future__ import annotations
 
 from typing import Protocol
 
+import numpy as np
+
 from camcad.geometry.envelope import Guide, LineElement, PointElement
 from camcad.motion.program import Motion
 
-__all__ = ["Follower"]
+__all__ = ["Follower", "slide_point"]
+
+
+def slide_point(x: float, height: float, motion: Motion) -> PointElement:
+    """A point on a slide along the machine's +y at x [mm]: (x, height + s) and its φ-derivatives.
+
+    M = (x, h + s), M′ = (0, v), M″ = (0, a), M‴ = (0, j): the roller centre of
+    a translating roller (h = k) or the face centre of a translating face (h = r_b).
+    """
+    zero = np.zeros_like(motion.s)
+    return PointElement(
+        m0=np.column_stack((zero + x, height + motion.s)),
+        m1=np.column_stack((zero, motion.v)),
+        m2=np.column_stack((zero, motion.a)),
+        m3=np.column_stack((zero, motion.j)),
+    )
 
 
 class Follower(Protocol):

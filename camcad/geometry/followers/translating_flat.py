@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from camcad.geometry.envelope import Guide, LineElement, PointElement
+from camcad.geometry.followers.base import slide_point
 from camcad.motion.program import Motion
 
 __all__ = ["TranslatingFlat"]
@@ -46,13 +47,7 @@ class TranslatingFlat:
 
     def trace(self, motion: Motion) -> PointElement:
         """The face centre (e, r_b + s): the point of the face on the slide's axis."""
-        zero = np.zeros_like(motion.s)
-        return PointElement(
-            m0=np.column_stack((zero + self.eccentricity, self.base_radius + motion.s)),
-            m1=np.column_stack((zero, motion.v)),
-            m2=np.column_stack((zero, motion.a)),
-            m3=np.column_stack((zero, motion.j)),
-        )
+        return slide_point(self.eccentricity, self.base_radius, motion)
 
     def describe(self) -> str:
         """E.g. ``"translating flat face, e = 0 mm"``."""

@@ -5,9 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from camcad.geometry.envelope import Guide, PointElement
+from camcad.geometry.followers.base import slide_point
 from camcad.motion.program import Motion
 
 __all__ = ["TranslatingRoller"]
@@ -37,13 +36,7 @@ class TranslatingRoller:
 
     def element(self, motion: Motion) -> PointElement:
         """M = (e, k + s), M′ = (0, v), M″ = (0, a), M‴ = (0, j) [mm/radᵏ]."""
-        zero = np.zeros_like(motion.s)
-        return PointElement(
-            m0=np.column_stack((zero + self.eccentricity, self.prime_k + motion.s)),
-            m1=np.column_stack((zero, motion.v)),
-            m2=np.column_stack((zero, motion.a)),
-            m3=np.column_stack((zero, motion.j)),
-        )
+        return slide_point(self.eccentricity, self.prime_k, motion)
 
     def trace(self, motion: Motion) -> PointElement:
         """The roller centre: the element itself."""
