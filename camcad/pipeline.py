@@ -157,42 +157,31 @@ def analyse(
         ),
     )
     later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
-    fitted = None
+    fitted = planned = None
     if fit and not hard:
-        try:
-            fitted = _timed(
-                timings,
-                progress,
-                "fit",
-                lambda: fit_cam_profile(
-                    cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
-                ),
-            )
-        except FitError as err:
-            if strict:
-                raise
-            later.append(_hard_finding("fit tolerance", "fit.tolerance", err))
-    planned = None
+        fitted = _limited(
+            lambda: fit_cam_profile(
+                cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
+            ),
+            timings=timings,
+            progress=progress,
+            stage="fit",
+            strict=strict,
+            found=later,
+        )
     if toolpath and not hard:
         from camcad.toolpath import plan_toolpath
 
-        try:
-            planned = _timed(
-                timings,
-                progress,
-                "toolpath",
-                lambda: plan_toolpath(
-                    cam,
-                    design.gcode,
-                    name=design.cam.name,
-                    thickness=design.cam.thickness,
-                    bore=design.cam.bore,
-                ),
-            )
-        except GougeError as err:
-            if strict:
-                raise
-            later.append(_hard_finding("gouge", "gcode.tool_diameter", err))
+        planned = _limited(
+            lambda: plan_toolpath(
+                cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
+            ),
+            timings=timings,
+            progress=progress,
+            stage="toolpath",
+            strict=strict,
+            found=later,
+        )
     program = None
     if planned is not None:
         from camcad.export.gcode import render_program
@@ -210,6 +199,33 @@ def analyse(
         timings=timings,
         stage_findings=tuple(later),
     )
+
+
+_STAGE_LIMITS: dict[str, tuple[type[DesignLimitError], str, str]] = {
+    "fit": (FitError, "fit tolerance", "fit.tolerance"),
+    "toolpath": (GougeError, "gouge", "gcode.tool_diameter"),
+}
+"""The hard limit each later stage can break: its error, the finding's kind, the default field."""
+
+
+def _limited(
+    run: Callable[[], Any],
+    *,
+    timings: dict[str, float],
+    progress: Progress | None,
+    stage: str,
+    strict: bool,
+    found: list[Finding],
+) -> Any:
+    """Run a stage that can break a hard limit: raise it when strict, else record a finding and give None."""
+    error, kind, field = _STAGE_LIMITS[stage]
+    try:
+        return _timed(timings, progress, stage, run)
+    except error as err:
+        if strict:
+            raise
+        found.append(_hard_finding(kind, field, err))
+        return None
 
 
 def _hard_finding(kind: str, field: str, err: Exception) -> Finding:

@@ -213,21 +213,7 @@ def analyse_dynamics(
     margin = dyn.min_contact_force
     spring_preload = spring_from_spec(dyn).preload
 
-    def rows(r: _Pointwise) -> FloatArray:
-        return _reported(r, margin=margin, omega=omega, preload=spring_preload)
-
-    values = rows(sampled)
-    if cam is None:
-        found = tuple(_sampled_extreme(phi, row, kind) for row, kind in zip(values, _KINDS, strict=True))
-    else:
-        exact = cam
-
-        def quantity(p: FloatArray, side: Side) -> FloatArray:
-            st = exact.state(p, side=side)
-            return rows(model(st.motion, st.pressure_angle, st.profile.rho))
-
-        joints = [bp.phi for bp in cam.program.breakpoints]
-        found = extremes_rows(quantity, phi, joints, _KINDS, values=values)
+    found = _extremes(model, sampled, phi, cam, margin=margin, omega=omega, preload=spring_preload)
     force_min, force_max, torque_min, torque_max, stress_max, need, flat_need, upper, lower = found
     preload = max(0.0, need.value)
     deflection = preload / _rate(dyn) if dyn.uses_coil_spring and _rate(dyn) > 0.0 else None
@@ -240,6 +226,85 @@ def analyse_dynamics(
     runs = loss_runs(motion.phi, sampled.force < margin)
     if not runs and force_min.value < margin:  # lost only between samples or just before/after a joint
         runs = ((force_min.phi % TWO_PI, force_min.phi % TWO_PI),)
+    findings = _findings(
+        dyn,
+        runs=runs,
+        omega=omega,
+        preload=preload,
+        deflection=deflection,
+        speeds=speeds,
+        force_min=force_min,
+        stress_max=stress_max,
+    )
+    warnings = [f.message for f in findings] + warnings
+    torque = np.asarray(sampled.torque, dtype=float)
+    readonly(phi, torque)
+    return DynamicsResult(
+        model=dyn.model,
+        phi=phi,
+        contact_force=sampled.force,
+        torque=torque,
+        hertz_stress=sampled.stress,
+        normal_force=sampled.force if sampled.near is not None else None,
+        guide_force_near=sampled.near,
+        guide_force_far=sampled.far,
+        margin=margin,
+        jump_ranges=runs,
+        min_preload=preload,
+        preload_deflection=deflection,
+        speed_range_rpm=speeds,
+        allowable_stress=dyn.allowable_stress,
+        warnings=tuple(warnings),
+        findings=tuple(findings),
+        contact_force_min=force_min,
+        contact_force_max=force_max,
+        torque_min=torque_min,
+        torque_max=torque_max,
+        hertz_stress_max=stress_max,
+    )
+
+
+def _extremes(
+    model: Callable[[Motion, FloatArray, FloatArray], _Pointwise],
+    sampled: _Pointwise,
+    phi: FloatArray,
+    cam: Cam | None,
+    *,
+    margin: float,
+    omega: float,
+    preload: float,
+) -> tuple[Extreme, ...]:
+    """The true extremes of every reported quantity (``_KINDS``), or the samples' without a cam."""
+
+    def rows(r: _Pointwise) -> FloatArray:
+        return _reported(r, margin=margin, omega=omega, preload=preload)
+
+    values = rows(sampled)
+    if cam is None:
+        return tuple(_sampled_extreme(phi, row, kind) for row, kind in zip(values, _KINDS, strict=True))
+    exact = cam
+
+    def quantity(p: FloatArray, side: Side) -> FloatArray:
+        st = exact.state(p, side=side)
+        return rows(model(st.motion, st.pressure_angle, st.profile.rho))
+
+    joints = [bp.phi for bp in cam.program.breakpoints]
+    return extremes_rows(quantity, phi, joints, _KINDS, values=values)
+
+
+def _findings(
+    dyn: DynamicsSpec,
+    *,
+    runs: tuple[tuple[float, float], ...],
+    omega: float,
+    preload: float,
+    deflection: float | None,
+    speeds: tuple[float, float] | None,
+    force_min: Extreme,
+    stress_max: Extreme,
+) -> list[Finding]:
+    """The soft limits the dynamics breaks: follower jump (with its remedies) and Hertz stress."""
+    margin = dyn.min_contact_force
     findings: list[Finding] = []
     if runs:
         message = _jump_warning(
@@ -268,32 +333,7 @@ def analyse_dynamics(
                 "MPa",
             )
         )
-    warnings = [f.message for f in findings] + warnings
-    torque = np.asarray(sampled.torque, dtype=float)
-    readonly(phi, torque)
-    return DynamicsResult(
-        model=dyn.model,
-        phi=phi,
-        contact_force=sampled.force,
-        torque=torque,
-        hertz_stress=sampled.stress,
-        normal_force=sampled.force if sampled.near is not None else None,
-        guide_force_near=sampled.near,
-        guide_force_far=sampled.far,
-        margin=margin,
-        jump_ranges=runs,
-        min_preload=preload,
-        preload_deflection=deflection,
-        speed_range_rpm=speeds,
-        allowable_stress=dyn.allowable_stress,
-        warnings=tuple(warnings),
-        findings=tuple(findings),
-        contact_force_min=force_min,
-        contact_force_max=force_max,
-        torque_min=torque_min,
-        torque_max=torque_max,
-        hertz_stress_max=stress_max,
-    )
+    return findings
 
 
 def _reported(r: _Pointwise, *, margin: float, omega: float, preload: float) -> FloatArray:
