@@ -66,7 +66,7 @@ _CONTINUOUS_RTOL = 1e-9  # one-sided limits this close are one value: no "just b
 _ITERATIONS = 60  # at most; a golden step alone shrinks a bracket by 0.618 (0.618^60 ≈ 3e-13)
 _XTOL = 1e-11  # rad: the smallest step the search takes
 _XSTOP = 1e-9  # rad: a parabolic step this small has converged (the value's error is ~q″·1e-18)
-# Where a piece's first and last sample gaps are probed, as fractions of the gap (see _end_brackets):
+# Where a piece's first and last sample gaps are probed, as fractions of the gap (see _probe_end_gaps):
 # next to both ends, which catches a peak right beside a joint, and at eighths.
 _END_PROBES = np.array([1e-3, *(np.arange(1, 8) / 8), 1.0 - 1e-3])
 

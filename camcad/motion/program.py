@@ -10,12 +10,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
+from camcad.extremes import Side
 from camcad.motion.segments import SegmentKind, SegmentSpec
 
 __all__ = [
@@ -27,8 +27,6 @@ __all__ = [
     "TimeMotion",
 ]
 
-Side = Literal["left", "right"]
-"""Which one-sided limit to take at a joint: ``"left"`` (just before), ``"right"`` (just after)."""
 _SNAP = 1e-12  # a normalised x this close to a law's breakpoint is that breakpoint
 # A jump smaller than this (relative to the derivative's scale) is continuity.
 _JUMP_RTOL = 1e-9
