@@ -146,10 +146,19 @@ def _tab_windows(cam: Cam, spec: GcodeSpec, phi0: float) -> list[tuple[float, fl
     half = 0.5 * spec.tab_width + spec.tool_radius
     lead = spec.lead_radius if spec.lead_radius is not None else spec.tool_diameter
     if half >= 0.5 * spacing - 0.5 * lead:
+        # each tab needs its width + the tool diameter, and room for a lead between tabs
+        most = math.floor(total / (2.0 * half + lead) - 1e-9)
+        widest = spacing - lead - spec.tool_diameter
+        room = f"{spec.tab_count} tabs of {spec.tab_width:g} mm (plus the tool Ø{spec.tool_diameter:g} mm) "
+        room += f"do not fit around the {total:.1f} mm contour"
+        if most >= 1:
+            raise DesignError(
+                "gcode.tab_count",
+                f"{room}; allowed: at most {most} tab(s) of this width"
+                + (f", or tabs narrower than {widest:.2f} mm" if widest > 0 else ""),
+            )
         raise DesignError(
-            "gcode.tab_width",
-            f"{spec.tab_count} tabs of {spec.tab_width:g} mm (plus the tool Ø{spec.tool_diameter:g} mm) "
-            f"do not fit around the {total:.1f} mm contour; use fewer or narrower tabs",
+            "gcode.tab_width", f"{room}: not even one fits; use narrower tabs or a smaller tool"
         )
     out = []
     for i in range(spec.tab_count):

@@ -7,6 +7,7 @@ back by the G-code reader, and measures it against ``cam.offset(φ, r)``.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from functools import cache
 
@@ -179,8 +180,19 @@ def test_bad_settings_are_design_errors():
         plan_toolpath(cam, replace(design.gcode, tolerance=0.0003), name="x", thickness=8.0)
     with pytest.raises(DesignError, match=r"gcode\.tab_height"):
         plan_toolpath(cam, replace(design.gcode, tab_count=2, tab_height=8.0), name="x", thickness=8.0)
-    with pytest.raises(DesignError, match=r"gcode\.tab_width"):
+    with pytest.raises(DesignError, match=r"gcode\.tab_width: .* not even one fits"):
+        plan_toolpath(cam, replace(design.gcode, tab_count=1, tab_width=5000.0), name="x", thickness=8.0)
+
+
+def test_too_many_tabs_name_the_count_that_fits():
+    """The advised count is the true limit: that many tabs plan, one more does not."""
+    design, cam, _ = planned("climb")
+    with pytest.raises(DesignError, match=r"gcode\.tab_count: .* at most (\d+) tab") as info:
         plan_toolpath(cam, replace(design.gcode, tab_count=40, tab_width=10.0), name="x", thickness=8.0)
+    most = int(re.search(r"at most (\d+) tab", str(info.value)).group(1))
+    plan_toolpath(cam, replace(design.gcode, tab_count=most, tab_width=10.0), name="x", thickness=8.0)
+    with pytest.raises(DesignError, match=r"gcode\.tab_count"):
+        plan_toolpath(cam, replace(design.gcode, tab_count=most + 1, tab_width=10.0), name="x", thickness=8.0)
 
 
 def test_velocity_jump_is_refused():
