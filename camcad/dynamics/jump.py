@@ -17,13 +17,15 @@ import math
 
 import numpy as np
 
-from camcad._typing import ArrayLike
+from camcad._typing import ArrayLike, FloatArray
 from camcad.angles import TWO_PI
 
 __all__ = [
     "covering_arc",
     "loss_runs",
     "min_preload",
+    "preload_need",
+    "speed_bounds",
     "speed_limits",
     "speed_window",
 ]
@@ -59,10 +61,49 @@ def min_preload(
         the smallest contact force equals the margin (or exceeds it if 0
         already suffices).
     """
-    need = margin * np.asarray(ratio, dtype=float) - (
-        np.asarray(inertia, dtype=float) * omega**2 + np.asarray(static_without_preload, dtype=float)
+    need = preload_need(
+        inertia=inertia,
+        static_without_preload=static_without_preload,
+        ratio=ratio,
+        omega=omega,
+        margin=margin,
     )
     return max(0.0, float(np.max(need)))
+
+
+def preload_need(
+    *,
+    inertia: ArrayLike,
+    static_without_preload: ArrayLike,
+    ratio: ArrayLike,
+    omega: float,
+    margin: float = 0.0,
+) -> FloatArray:
+    """(n,) margin·c − A·ω² − (m·g + k·s) [N]: the preload each angle needs; see :func:`min_preload`."""
+    out: FloatArray = margin * np.asarray(ratio, dtype=float) - (
+        np.asarray(inertia, dtype=float) * omega**2 + np.asarray(static_without_preload, dtype=float)
+    )
+    return out
+
+
+def speed_bounds(
+    *, inertia: ArrayLike, static: ArrayLike, ratio: ArrayLike, margin: float = 0.0
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Per angle (n,): the need where A = 0, and the ω² bounds from above and from below.
+
+    Returns ``(flat, upper, lower)``: ``flat`` = margin·c − B where A = 0
+    (must be ≤ 0), else −inf; ``upper`` = (margin·c − B)/A where A < 0 (ω²
+    must stay below its minimum), else +inf; ``lower`` the same where A > 0
+    (ω² must exceed its maximum), else −inf. See :func:`speed_limits`.
+    """
+    a = np.asarray(inertia, dtype=float)
+    need = margin * np.asarray(ratio, dtype=float) - np.asarray(static, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bound = need / a
+    flat: FloatArray = np.where(a == 0.0, need, -np.inf)
+    upper: FloatArray = np.where(a < 0.0, bound, np.inf)
+    lower: FloatArray = np.where(a > 0.0, bound, -np.inf)
+    return flat, upper, lower
 
 
 def speed_limits(
@@ -94,18 +135,10 @@ def speed_limits(
     follower decelerates, the spring must hold it), from below where A > 0
     and B alone falls short. Where A = 0 it needs B ≥ margin·c.
     """
-    a = np.asarray(inertia, dtype=float)
-    need = margin * np.asarray(ratio, dtype=float) - np.asarray(static, dtype=float)
-    flat = a == 0.0
-    if np.any(need[flat] > 0.0):
+    flat, upper, lower = speed_bounds(inertia=inertia, static=static, ratio=ratio, margin=margin)
+    if np.max(flat, initial=-np.inf) > 0.0:
         return None
-    with np.errstate(divide="ignore", invalid="ignore"):
-        bound = need / a  # ω² ≤ bound where A < 0, ω² ≥ bound where A > 0
-    upper = bound[a < 0.0]
-    lower = bound[a > 0.0]
-    w2_high = float(np.min(upper)) if upper.size else math.inf
-    w2_low = float(np.max(lower)) if lower.size else 0.0
-    return speed_window(w2_low, w2_high)
+    return speed_window(float(np.max(lower, initial=0.0)), float(np.min(upper, initial=math.inf)))
 
 
 def speed_window(w2_low: float, w2_high: float) -> tuple[float, float] | None:

@@ -18,7 +18,7 @@ from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
 from camcad.dynamics.contact import contact_curvature, effective_modulus, hertz_stress
 from camcad.dynamics.energy import FollowerLoad, contact_force, input_torque
-from camcad.dynamics.jump import covering_arc, loss_runs, speed_window
+from camcad.dynamics.jump import covering_arc, loss_runs, preload_need, speed_bounds, speed_window
 from camcad.dynamics.results import DynamicsResult
 from camcad.dynamics.spec import DynamicsModel, DynamicsSetup, DynamicsSpec
 from camcad.dynamics.spring import spring_from_spec
@@ -345,22 +345,15 @@ def _reported(r: _Pointwise, *, margin: float, omega: float, preload: float) -> 
     margin·c − B must be ≤ 0, ω² ≤ (margin·c − B)/A where A < 0 (its min),
     ω² ≥ (margin·c − B)/A where A > 0 (its max).
     """
-    need_speed = margin * r.ratio - r.static
-    with np.errstate(divide="ignore", invalid="ignore"):
-        bound = need_speed / r.inertia
-    return np.vstack(
-        (
-            r.force,
-            r.force,
-            r.torque,
-            r.torque,
-            r.stress,
-            margin * r.ratio - r.inertia * omega**2 - (r.static - preload),
-            np.where(r.inertia == 0.0, need_speed, -np.inf),
-            np.where(r.inertia < 0.0, bound, np.inf),
-            np.where(r.inertia > 0.0, bound, -np.inf),
-        )
+    need = preload_need(
+        inertia=r.inertia,
+        static_without_preload=r.static - preload,
+        ratio=r.ratio,
+        omega=omega,
+        margin=margin,
     )
+    flat, upper, lower = speed_bounds(inertia=r.inertia, static=r.static, ratio=r.ratio, margin=margin)
+    return np.vstack((r.force, r.force, r.torque, r.torque, r.stress, need, flat, upper, lower))
 
 
 def _guide_notes(phi: FloatArray, sampled: _Pointwise, dyn: DynamicsSpec) -> list[str]:
