@@ -13,6 +13,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
+import numpy as np
+
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import (
@@ -250,6 +252,18 @@ class Cam:
             pressure_angle=alpha,
             contact_x=contact[:, 0] - self.eccentricity,
         )
+
+    def loop_radius(self, state: CamState) -> FloatArray:
+        """(n,) the radius that decides undercut [mm]: it must stay above :attr:`roller_radius`.
+
+        Roller: the convex pitch-curve radius (the profile loops where it falls
+        below r_f; +inf where the pitch curve is concave). Flat face: the
+        profile radius r_b + s + a (a cusp where it reaches 0).
+        """
+        if self.is_roller:
+            out: FloatArray = np.where(state.base.rho > 0.0, state.base.rho, np.inf)
+            return out
+        return state.profile.rho
 
     def pressure_angle(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
         """Signed pressure angle α [rad] at cam angles φ [rad].

@@ -120,9 +120,7 @@ def _undercut_quantity(cam: Cam) -> tuple[Quantity, float]:
     Roller: the convex pitch-curve radius must exceed r_f (else the profile
     loops). Flat face: the profile radius r_b + s + a must stay > 0 (else a cusp).
     """
-    if cam.is_roller:
-        return (lambda phi, side: _convex(cam.pitch(phi, side=side).rho)), cam.roller_radius
-    return (lambda phi, side: cam.profile(phi, side=side).rho), 0.0
+    return (lambda phi, side: cam.loop_radius(cam.state(phi, side=side))), cam.roller_radius
 
 
 def _bad_range(quantity: Quantity, limit: float, worst: Extreme, step: float) -> tuple[float, float]:
@@ -239,7 +237,7 @@ def analyse_geometry(
         st = cam.state(p, side=side)
         radius = np.hypot(st.profile.point[:, 0], st.profile.point[:, 1])
         rho = st.profile.rho
-        undercut = _convex(st.base.rho) if roller else rho
+        undercut = cam.loop_radius(st)
         x = st.contact_x
         return np.vstack(
             (np.abs(st.pressure_angle), radius, radius, _convex(rho), _concave(rho), undercut, x, x)

@@ -48,16 +48,11 @@ def feasible_margins(
     ``phi`` [rad] and taken at both sides of every joint.
     """
     joints = [bp.phi for bp in cam.program.breakpoints]
-    roller = cam.is_roller
 
     def rows(p: FloatArray, side: Side) -> FloatArray:
         """|α| and the convex profile radius (for a roller: convex pitch ρ − r_f)."""
         st = cam.state(p, side=side)
-        if roller:
-            rho = np.where(st.base.rho > 0, st.base.rho - cam.roller_radius, np.inf)
-        else:
-            rho = st.profile.rho
-        return np.vstack((np.abs(st.pressure_angle), rho))
+        return np.vstack((np.abs(st.pressure_angle), cam.loop_radius(st) - cam.roller_radius))
 
     worst_alpha, worst_rho = extremes_rows(rows, phi, joints, ("max", "min"))
     margin_rho = worst_rho.value - min_curvature_radius
