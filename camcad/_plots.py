@@ -264,44 +264,41 @@ def _bore_outline(bore: float, width: float, depth: float) -> FloatArray:
 def _draw_followers(ax: Axes, analysis: Analysis, reach: float) -> float:
     """Draw the follower at :data:`FOLLOWER_ANGLES_DEG` in the cam frame (kinematic inversion).
 
-    Returns the largest distance of a stem tip from the cam centre [mm].
+    The follower module draws itself (:meth:`Follower.sketch`): roller or face,
+    stem or arm, pivot. Returns the largest distance of a drawn point from the
+    cam centre [mm].
     """
-    cam, geo = analysis.cam, analysis.geometry
+    cam = analysis.cam
     phis = np.radians(np.asarray(FOLLOWER_ANGLES_DEG))
-    follower = cam.kinematics  # the drawing asks the follower, not a kind flag
-    trace = follower.trace(cam.motion(phis)).m0  # machine frame
-    centres = to_cam(phis, trace, cam.sigma)
-    axes = to_cam(phis, follower.guide.driven(trace), cam.sigma)  # the direction it is driven in
-    stem = 0.25 * reach
+    sketches = cam.kinematics.sketch(cam.motion(phis), size=reach)
     far = reach
-    if cam.is_roller:
-        half_face = 0.0
-    else:
-        width = analysis.design.follower.face_width
-        half_face = 0.5 * width if width else 0.6 * (geo.face_width_min or cam.base_radius)
-    for k, (phi, centre, axis_dir) in enumerate(zip(phis, centres, axes, strict=True)):
+    for k, (phi, sketch) in enumerate(zip(phis, sketches, strict=True)):
         color = _COLORS[(k + 1) % len(_COLORS)]
-        across = np.array([axis_dir[1], -axis_dir[0]])
-        if cam.is_roller:
-            r = cam.roller_radius
-            ax.add_patch(Circle(tuple(centre), r, fill=False, edgecolor=color, linewidth=1.4))
-            ax.plot(*centre, marker="+", color=color, markersize=6)
-            foot = centre + r * axis_dir
-        else:
-            face = np.array([centre - half_face * across, centre + half_face * across])
-            ax.plot(face[:, 0], face[:, 1], color=color, linewidth=2.4, solid_capstyle="butt")
-            foot = centre
-        tip = foot + stem * axis_dir
+
+        def seen(points: np.ndarray, phi: float = phi) -> np.ndarray:
+            return to_cam(np.full(len(points), phi), np.asarray(points, dtype=float), cam.sigma)
+
+        for part in sketch.body:
+            xy = seen(part)
+            ax.plot(xy[:, 0], xy[:, 1], color=color, linewidth=1.4 if len(part) > 2 else 2.4)
+            far = max(far, float(np.hypot(*xy.T).max()))
+        for part in sketch.links:
+            xy = seen(part)
+            ax.plot(xy[:, 0], xy[:, 1], color=color, linewidth=2.0)
+            far = max(far, float(np.hypot(*xy.T).max()))
+        for part in sketch.axes:
+            xy = seen(part)
+            ax.plot(xy[:, 0], xy[:, 1], color=color, linewidth=0.6, linestyle="-.", alpha=0.7)
+        if len(sketch.marks):
+            xy = seen(sketch.marks)
+            ax.plot(xy[:, 0], xy[:, 1], linestyle="none", marker="+", color=color, markersize=6)
+        tip = seen(sketch.tip[None, :])[0]
+        dx, dy = to_cam(np.array([phi]), sketch.heading[None, :], cam.sigma)[0]
         far = max(far, float(np.hypot(*tip)))
-        ax.plot([foot[0], tip[0]], [foot[1], tip[1]], color=color, linewidth=2.0)
-        # the follower axis, thin and dash-dotted, through the centre
-        back = centre - float(np.dot(centre, axis_dir)) * axis_dir  # foot of the axis nearest the cam centre
-        ax.plot([back[0], tip[0]], [back[1], tip[1]], color=color, linewidth=0.6, linestyle="-.", alpha=0.7)
-        # the label just beyond the stem tip, aligned so it never covers the stem
-        dx, dy = axis_dir
+        # the label just beyond the tip, aligned so it never covers the follower
         ha = "center" if abs(dx) < 0.4 else ("left" if dx > 0 else "right")
         va = "center" if abs(dy) < 0.4 else ("bottom" if dy > 0 else "top")
-        label = tip + 0.03 * reach * axis_dir
+        label = tip + 0.03 * reach * np.array([dx, dy])
         ax.text(label[0], label[1], f"φ = {math.degrees(phi):g}°", color=color, fontsize=8, ha=ha, va=va)
     return far
 
@@ -324,7 +321,11 @@ def _profile_plot(analysis: Analysis) -> Plot:
         color="#d9731a",
         linewidth=1.0,
         linestyle="--",
-        label="pitch curve" if cam.is_roller else "face-centre trace",
+        label="pitch curve"
+        if cam.is_roller
+        else "face trace (point nearest the cam axis)"
+        if cam.kinematics.guide.pivot is not None
+        else "face-centre trace",
     )
     ax.add_patch(
         Circle((0.0, 0.0), cam.base_radius, fill=False, edgecolor="#7f7f7f", linestyle=":", linewidth=1.0)

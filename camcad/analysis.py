@@ -108,7 +108,8 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
     Where the velocity jumps (``velocity_jumps_deg``) the acceleration is an
     impulse: the peaks of |a| and |j| are infinite and reported as ``None``.
     """
-    out: dict[str, Any] = {"lift_mm": cam.program.lift}
+    u = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    out: dict[str, Any] = {f"lift_{u}": cam.program.lift}
     joints = [bp.phi for bp in cam.program.breakpoints]
     # where v jumps, a is an impulse and j is undefined: their peaks are infinite, not the samples'
     impulses = [round(math.degrees(bp.phi), 6) for bp in cam.program.breakpoints if bp.continuity == 0]
@@ -121,7 +122,7 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
     values = np.abs(np.vstack((motion.v, motion.a, motion.j)))
     peaks = extremes_rows(rows, motion.phi, joints, ("max", "max", "max"), values=values)
     for (key, unit), peak in zip(
-        (("v", "mm_per_rad"), ("a", "mm_per_rad2"), ("j", "mm_per_rad3")), peaks, strict=True
+        (("v", f"{u}_per_rad"), ("a", f"{u}_per_rad2"), ("j", f"{u}_per_rad3")), peaks, strict=True
     ):
         if impulses and key != "v":
             out[f"{key}_max_abs_{unit}"] = None  # infinite at the velocity jumps
@@ -135,9 +136,9 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
         {
             "angle_deg": math.degrees(j.phi),
             "segment": j.index,
-            "dv_mm_per_rad": j.dv,
-            "da_mm_per_rad2": j.da,
-            "dj_mm_per_rad3": j.dj,
+            f"dv_{u}_per_rad": j.dv,
+            f"da_{u}_per_rad2": j.da,
+            f"dj_{u}_per_rad3": j.dj,
             "continuity": j.continuity,
             "text": j.describe(),
         }

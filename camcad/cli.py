@@ -107,7 +107,11 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
     fit = summary.get("fit") or {}
     limit = math.degrees(design.cam.max_pressure_angle)
     return [
-        ("lift", _fmt(summary["motion"]["lift_mm"], " mm")),
+        (
+            ("lift", _fmt(summary["motion"]["lift_mm"], " mm"))
+            if "lift_mm" in summary["motion"]
+            else ("arm swing", _fmt(summary["motion"]["lift_deg"], "°"))
+        ),
         (
             "max pressure angle",
             _fmt(geo["pressure_angle_max_deg"], "°", 2)
@@ -162,16 +166,23 @@ def _cmd_check(args: argparse.Namespace) -> int:
 def _cmd_size(args: argparse.Namespace) -> int:
     from camcad.design import load_design
     from camcad.extremes import Extreme
-    from camcad.geometry import Cam, min_base_radius
+    from camcad.geometry import Cam, min_base_radius, min_pivot_distance
 
     design = load_design(args.design)
     cam = Cam.from_design(design)
-    result = min_base_radius(
+    search = min_pivot_distance if args.pivot else min_base_radius
+    result = search(
         cam,
         max_pressure_angle=design.cam.max_pressure_angle,
         min_curvature_radius=design.min_curvature_radius,
     )
-    print(f"smallest base radius: {result.base_radius:.3f} mm (design has {design.cam.base_radius:g} mm)")
+    if args.pivot:
+        print(
+            f"smallest pivot distance: {result.pivot_distance:.3f} mm "
+            f"(design has {design.follower.pivot_distance:g} mm, base radius {design.cam.base_radius:g} mm)"
+        )
+    else:
+        print(f"smallest base radius: {result.base_radius:.3f} mm (design has {design.cam.base_radius:g} mm)")
     where = Extreme(value=0.0, phi=result.angle, side=result.side).where()
     print(f"  limited by {result.limit} {where.replace('at ', 'at cam angle ', 1)}")
     print(
@@ -253,6 +264,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("size", help="smallest base radius meeting the pressure-angle and curvature limits")
     p.add_argument("design", help="design file (TOML)")
+    p.add_argument(
+        "--pivot",
+        action="store_true",
+        help="oscillating followers: the smallest pivot distance at the design's base radius instead",
+    )
     p.set_defaults(handler=_cmd_size)
 
     p = sub.add_parser("compare", help="compare designs side by side (table, and overlay plots with -o)")

@@ -343,14 +343,15 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
     step = math.radians(MOTION_TABLE_STEP_DEG)
     grid = np.arange(round(2 * math.pi / step)) * step
     m = cam.motion(grid)
+    u = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     motion_csv = write_csv(
         folder / "motion.csv",
         {
             "angle_deg": np.degrees(grid),
-            "s_mm": m.s,
-            "v_mm_per_rad": m.v,
-            "a_mm_per_rad2": m.a,
-            "j_mm_per_rad3": m.j,
+            f"s_{u}": m.s,
+            f"v_{u}_per_rad": m.v,
+            f"a_{u}_per_rad2": m.a,
+            f"j_{u}_per_rad3": m.j,
         },
     )
     profile_csv = write_csv(

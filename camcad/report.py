@@ -241,10 +241,11 @@ def _key_numbers(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, An
     dyn = summary.get("dynamics", {})
     fit = summary.get("fit")
     d = analysis.dynamics
+    unit = analysis.cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     return {
-        "lift": motion.get("lift_mm", analysis.cam.program.lift),
-        "v": motion.get("v_max_abs_mm_per_rad", _peak(np.abs(analysis.motion.v))),
-        "a": motion.get("a_max_abs_mm_per_rad2", _peak(np.abs(analysis.motion.a))),
+        "lift": analysis.cam.program.lift,
+        "v": motion.get(f"v_max_abs_{unit}_per_rad", _peak(np.abs(analysis.motion.v))),
+        "a": motion.get(f"a_max_abs_{unit}_per_rad2", _peak(np.abs(analysis.motion.a))),
         "alpha": geo.get(
             "pressure_angle_max_deg", math.degrees(float(np.abs(analysis.geometry.pressure_angle).max()))
         ),

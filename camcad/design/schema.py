@@ -37,7 +37,7 @@ from camcad.dynamics.spec import DynamicsModel, DynamicsSpec
 from camcad.errors import DesignError
 from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fit.spec import FitSpec
-from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
+from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation, arm_problem
 from camcad.motion.laws import LAWS, make_law
 from camcad.motion.segments import SegmentKind, SegmentSpec
 
@@ -225,6 +225,9 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "offset": _Rule("float", check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm"), attr="eccentricity"),
         "face_width": _Rule("float", check=_length),
         "face_margin": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
+        "pivot_distance": _Rule("float", check=_length),
+        "arm_length": _Rule("float", check=_length),
+        "face_offset": _Rule("float", check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm")),
     },
     "dynamics": {
         "model": _Rule("enum", enum=DynamicsModel),
@@ -250,6 +253,15 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "follower_modulus": _Rule("float", check=_modulus),
         "follower_poisson": _Rule("float", check=_poisson),
         "allowable_stress": _Rule("float", check=_modulus),
+        "arm_inertia": _Rule("float", check=_between(0.0, MAX_MASS_KG * MAX_LENGTH_MM**2, " kg·mm²")),
+        "spring_rate_torsional": _Rule(
+            "float", check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N·mm/rad")
+        ),
+        "spring_preload_torsional": _Rule(
+            "float", check=_between(-MAX_FORCE_N * MAX_LENGTH_MM, MAX_FORCE_N * MAX_LENGTH_MM, " N·mm")
+        ),
+        "spring_arm": _Rule("float", check=_length),
+        "cg_distance": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
     },
     "fit": {
         "tolerance": _Rule("float", check=_between(MIN_FIT_TOL_MM, MAX_TOLERANCE_MM, " mm")),
@@ -456,7 +468,8 @@ def _segment(index: int, table: Any) -> SegmentSpec:
     return SegmentSpec(kind=kind, span=span * DEG, lift=lift, law=law)
 
 
-def _check_program(segments: tuple[SegmentSpec, ...]) -> None:
+def _check_program(segments: tuple[SegmentSpec, ...], *, unit: str = " mm") -> None:
+    """The spans total 360° and the lift closes, never going below the base circle (lift in ``unit``)."""
     if not segments:
         raise DesignError("motion", "at least one [[motion]] segment is required")
     total = sum(seg.span for seg in segments) / DEG
@@ -470,7 +483,7 @@ def _check_program(segments: tuple[SegmentSpec, ...]) -> None:
             if s > MAX_LENGTH_MM:
                 raise DesignError(
                     f"motion[{i}].lift",
-                    f"{seg.lift:g} mm takes the follower {s:g} mm above the base circle; "
+                    f"{seg.lift:g}{unit} takes the follower {s:g}{unit} above the base circle; "
                     f"allowed: a total lift of at most {MAX_LENGTH_MM:g} mm",
                 )
         elif seg.kind is SegmentKind.RETURN:
@@ -478,13 +491,13 @@ def _check_program(segments: tuple[SegmentSpec, ...]) -> None:
             if s < -LIFT_CLOSE_TOL_MM:
                 raise DesignError(
                     f"motion[{i}].lift",
-                    f"return of {seg.lift:g} mm takes the follower {-s:g} mm below the base circle",
+                    f"return of {seg.lift:g}{unit} takes the follower {-s:g}{unit} below the base circle",
                 )
     if abs(s) > LIFT_CLOSE_TOL_MM:
         rises = sum(g.lift for g in segments if g.kind is SegmentKind.RISE)
         raise DesignError(
             "motion",
-            f"the lift does not close: total rise {rises:g} mm but total return {rises - s:g} mm",
+            f"the lift does not close: total rise {rises:g}{unit} but total return {rises - s:g}{unit}",
         )
 
 
@@ -499,19 +512,41 @@ def _check_design(design: Design) -> None:
 
 def _check_follower(design: Design) -> None:
     cam, fol = design.cam, design.follower
+    if fol.kind.roller and fol.roller_radius <= 0:
+        raise DesignError(
+            "follower.roller_radius",
+            f"{fol.roller_radius:g} must be > 0 for a {fol.kind.value} follower "
+            f"(allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
+        )
     if fol.kind is FollowerKind.TRANSLATING_ROLLER:
-        if fol.roller_radius <= 0:
-            raise DesignError(
-                "follower.roller_radius",
-                f"{fol.roller_radius:g} must be > 0 for a translating-roller follower "
-                f"(allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
-            )
         if abs(fol.eccentricity) >= cam.base_radius + fol.roller_radius:
             raise DesignError(
                 "follower.offset",
                 f"|{fol.eccentricity:g}| must be smaller than base_radius + roller_radius = "
                 f"{cam.base_radius + fol.roller_radius:g} mm",
             )
+    if fol.kind.oscillating:
+        _check_arm(design)
+
+
+def _check_arm(design: Design) -> None:
+    """An oscillating follower's pivot and arm must make a triangle with the cam axis and swing clear."""
+    swing = max(_lift_profile(design.motion))  # degrees
+    problem = arm_problem(design.follower, design.cam.base_radius, swing)
+    if problem is not None:
+        raise DesignError(*problem)
+
+
+def _lift_profile(segments: tuple[SegmentSpec, ...]) -> list[float]:
+    """The follower's position after each segment (lift units), starting at 0."""
+    out, s = [0.0], 0.0
+    for seg in segments:
+        if seg.kind is SegmentKind.RISE:
+            s += seg.lift
+        elif seg.kind is SegmentKind.RETURN:
+            s -= seg.lift
+        out.append(s)
+    return out
 
 
 def _check_bore(cam: CamSpec) -> None:
@@ -554,6 +589,16 @@ def _check_dynamics(design: Design) -> None:
         raise DesignError(
             "dynamics.wire_diameter",
             f"{dyn.wire_diameter:g} mm must be smaller than the mean coil diameter {dyn.coil_diameter:g} mm",
+        )
+    if fol.kind.oscillating and (dyn.spring_rate > 0 or dyn.spring_preload != 0) and dyn.spring_arm is None:
+        raise DesignError(
+            "dynamics.spring_arm",
+            "is required for a linear spring on an oscillating follower (mm, the spring's lever about "
+            "the pivot); or give spring_rate_torsional and spring_preload_torsional for a torsion spring",
+        )
+    if fol.kind.oscillating and dyn.uses_coil_spring:
+        raise DesignError(
+            "dynamics.wire_diameter", "coil-spring geometry applies to translating followers only"
         )
     if dyn.model is DynamicsModel.GUIDED_TAPPET:
         if fol.kind is not FollowerKind.TRANSLATING_FLAT:
@@ -611,6 +656,55 @@ def _check_gcode(design: Design) -> None:
         )
 
 
+# Keys that belong to one family of follower only, and the keys each kind requires.
+_SLIDE_ONLY = ("offset",)
+_ARM_ONLY = ("pivot_distance", "arm_length", "face_offset")
+_ARM_DYNAMICS = (
+    "arm_inertia",
+    "spring_rate_torsional",
+    "spring_preload_torsional",
+    "spring_arm",
+    "cg_distance",
+)
+_REQUIRED: dict[FollowerKind, tuple[str, ...]] = {
+    FollowerKind.TRANSLATING_ROLLER: ("roller_radius",),
+    FollowerKind.TRANSLATING_FLAT: (),
+    FollowerKind.OSCILLATING_ROLLER: ("roller_radius", "pivot_distance", "arm_length"),
+    FollowerKind.OSCILLATING_FLAT: ("pivot_distance",),
+}
+
+
+def _check_follower_keys(kind: FollowerKind, follower: Mapping[str, Any], dynamics: Any) -> None:
+    """Each follower kind's required keys present, and no key of the other family."""
+    for key in _REQUIRED[kind]:
+        if key not in follower:
+            raise DesignError(f"follower.{key}", f"is required for a {kind.value} follower (mm)")
+    wrong = _SLIDE_ONLY if kind.oscillating else _ARM_ONLY
+    for key in wrong:
+        if key in follower:
+            family = "translating" if kind.oscillating else "oscillating"
+            raise DesignError(
+                f"follower.{key}", f"applies to {family} followers only, not to a {kind.value} follower"
+            )
+    if kind is FollowerKind.OSCILLATING_FLAT and "arm_length" in follower:
+        raise DesignError("follower.arm_length", "applies to an oscillating-roller follower only")
+    if kind is FollowerKind.OSCILLATING_ROLLER and "face_offset" in follower:
+        raise DesignError("follower.face_offset", "applies to an oscillating-flat follower only")
+    if isinstance(dynamics, Mapping):
+        for key in _ARM_DYNAMICS:
+            if key in dynamics and not kind.oscillating:
+                raise DesignError(
+                    f"dynamics.{key}", f"applies to oscillating followers only, not {kind.value}"
+                )
+        if "spring_arm" in dynamics and (
+            "spring_rate_torsional" in dynamics or "spring_preload_torsional" in dynamics
+        ):
+            raise DesignError(
+                "dynamics.spring_arm",
+                "a linear spring at a lever arm and a torsion spring cannot both be given; choose one",
+            )
+
+
 def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
     """Validate a design given as a TOML-like mapping.
 
@@ -629,11 +723,7 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
     for name, cls in _SPEC_CLASSES.items():
         specs[name] = cls(**_section(name, data.get(name, {})))
     follower = specs["follower"]
-    if follower.kind is FollowerKind.TRANSLATING_ROLLER and "roller_radius" not in data.get("follower", {}):
-        raise DesignError(
-            "follower.roller_radius",
-            f"is required for a translating-roller follower (mm, {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g})",
-        )
+    _check_follower_keys(follower.kind, data.get("follower", {}), data.get("dynamics", {}))
     raw_motion = data.get("motion")
     if not isinstance(raw_motion, list):
         raise DesignError("motion", "expected one or more [[motion]] tables")
@@ -642,7 +732,7 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
             "motion", f"{len(raw_motion)} segments; allowed: at most {MAX_SEGMENTS} [[motion]] tables"
         )
     motion = tuple(_segment(i, seg) for i, seg in enumerate(raw_motion))
-    _check_program(motion)
+    _check_program(motion, unit="°" if follower.kind.oscillating else " mm")
     design = Design(motion=motion, source=source, **specs)
     _check_design(design)
     return design

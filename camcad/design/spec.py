@@ -17,8 +17,10 @@ from dataclasses import dataclass, field, replace
 from camcad.dynamics.spec import DynamicsSetup, DynamicsSpec
 from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fit.spec import FitSpec
+from camcad.geometry.cam import follower_from_spec
+from camcad.geometry.followers import OscillatingFlat, OscillatingRoller
 from camcad.geometry.plate import BoreOutline, Plate
-from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
+from camcad.geometry.spec import FollowerSpec, Rotation
 from camcad.motion.segments import SegmentSpec
 from camcad.toolpath.spec import Dialect, Direction, GcodeSpec
 
@@ -76,7 +78,7 @@ class Design:
     def dynamics_setup(self) -> DynamicsSetup:
         """The dynamics stage's options: ``[dynamics]`` with the speed and contact geometry it uses."""
         dyn, cam, fol = self.dynamics, self.cam, self.follower
-        roller = fol.kind is FollowerKind.TRANSLATING_ROLLER
+        roller = fol.kind.roller
         return DynamicsSetup(
             spec=dyn,
             omega=cam.omega,
@@ -85,6 +87,7 @@ class Design:
             roller_radius=fol.roller_radius if roller else 0.0,
             # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
             tappet_offset=fol.eccentricity if cam.rotation is Rotation.CCW else -fol.eccentricity,
+            arm_angle=_arm_direction(fol, cam.base_radius),
         )
 
     def with_base_radius(self, base_radius: float) -> Design:
@@ -96,4 +99,12 @@ class Design:
         """Required smallest convex profile radius [mm] (0 roller, 1 flat by default)."""
         if self.cam.min_curvature_radius is not None:
             return self.cam.min_curvature_radius
-        return 1.0 if self.follower.kind is FollowerKind.TRANSLATING_FLAT else 0.0
+        return 0.0 if self.follower.kind.roller else 1.0
+
+
+def _arm_direction(follower: FollowerSpec, base_radius: float) -> float | None:
+    """An oscillating follower's arm direction at ψ = 0 [rad], machine frame; None for a slide."""
+    module = follower_from_spec(follower, base_radius)
+    if isinstance(module, OscillatingRoller | OscillatingFlat):
+        return module.arm_direction
+    return None

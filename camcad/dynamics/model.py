@@ -16,6 +16,7 @@ import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
+from camcad.dynamics.arm import ArmLoad, arm_speed
 from camcad.dynamics.contact import contact_curvature, effective_modulus, hertz_stress
 from camcad.dynamics.energy import FollowerLoad, contact_force, input_torque
 from camcad.dynamics.jump import covering_arc, loss_runs, preload_need, speed_bounds, speed_window
@@ -52,6 +53,7 @@ def _arc_text(arc: tuple[float, float]) -> str:
 
 def _jump_warning(
     *,
+    torsional: bool,
     runs: tuple[tuple[float, float], ...],
     margin: float,
     omega: float,
@@ -69,7 +71,8 @@ def _jump_warning(
     else:
         head = f"follower jumps {where} {lowest}"
     # round the advice to the safe side: preload up, speed down
-    fix = f"raise the preload to ≥ {math.ceil(preload * 10.0 - 1e-9) / 10.0:.1f} N"
+    unit = "N·mm" if torsional else "N"
+    fix = f"raise the preload to ≥ {math.ceil(preload * 10.0 - 1e-9) / 10.0:.1f} {unit}"
     if deflection is not None:
         fix += f" (preload deflection ≥ {math.ceil(deflection * 100.0 - 1e-9) / 100.0:.2f} mm)"
     if speeds is None:
@@ -97,11 +100,48 @@ class _Pointwise:
     far: FloatArray | None = None
 
 
-def _model(setup: DynamicsSetup) -> Callable[[Motion, FloatArray, FloatArray], _Pointwise]:
-    """The design's dynamic model as a pointwise function of (motion, pressure angle α, profile ρ)."""
+_Model = Callable[["Motion", FloatArray, FloatArray, "FloatArray | None"], _Pointwise]
+
+
+def _arm_load(setup: DynamicsSetup) -> ArmLoad:
+    """An oscillating follower's load: torsion spring, or a linear spring at ``spring_arm``."""
+    dyn = setup.spec
+    assert setup.arm_angle is not None
+    if dyn.spring_arm is not None:
+        rate, preload = dyn.spring_rate * dyn.spring_arm**2, dyn.spring_preload * dyn.spring_arm
+    else:
+        rate, preload = dyn.spring_rate_torsional, dyn.spring_preload_torsional
+    return ArmLoad(
+        inertia=dyn.arm_inertia,
+        spring_rate=rate,
+        preload=preload,
+        mass=dyn.follower_mass if dyn.gravity else 0.0,
+        cg_distance=dyn.cg_distance,
+        arm_angle=setup.arm_angle,
+    )
+
+
+def _preload(setup: DynamicsSetup) -> float:
+    """The spring's preload in the model's generalised force: N on a slide, N·mm about an arm's pivot."""
+    if setup.arm_angle is None:
+        return spring_from_spec(setup.spec).preload
+    return _arm_load(setup).preload
+
+
+def _model(setup: DynamicsSetup) -> _Model:
+    """The design's dynamic model as a pointwise function of (motion, α, profile ρ, lever r).
+
+    ``lever`` is the distance from an oscillating follower's pivot to the
+    driven point [mm] (None for a slide): the contact force is the generalised
+    force over c = cos α (slide) or c = r·cos α (arm, :mod:`camcad.dynamics.arm`).
+    """
     dyn = setup.spec
     spring = spring_from_spec(dyn)
-    load = FollowerLoad(mass=dyn.follower_mass, spring=spring, gravity=dyn.gravity)
+    load: FollowerLoad | ArmLoad = (
+        FollowerLoad(mass=dyn.follower_mass, spring=spring, gravity=dyn.gravity)
+        if setup.arm_angle is None
+        else _arm_load(setup)
+    )
     omega = setup.omega
     roller = setup.roller_radius
     modulus = effective_modulus(
@@ -123,9 +163,14 @@ def _model(setup: DynamicsSetup) -> Callable[[Motion, FloatArray, FloatArray], _
             offset=setup.tappet_offset,
         )
 
-    def evaluate(motion: Motion, alpha: FloatArray, rho: FloatArray) -> _Pointwise:
+    def evaluate(motion: Motion, alpha: FloatArray, rho: FloatArray, lever: FloatArray | None) -> _Pointwise:
         near = far = None
-        if tappet is not None:
+        if lever is not None:  # an arm: moments about the pivot
+            moment = load.axial_force(motion, omega=omega)
+            ratio = lever * np.cos(alpha)
+            force = moment / ratio
+            torque = moment * arm_speed(motion) + dyn.friction_torque
+        elif tappet is not None:
             forces = tappet_forces(motion, load=load, omega=omega, tappet=tappet)
             force = forces.normal_force
             near, far = forces.guide_force_near, forces.guide_force_far
@@ -208,14 +253,21 @@ def analyse_dynamics(
     dyn = setup.spec
     omega = setup.omega
     model = _model(setup)
-    sampled = model(motion, alpha, rho)
+    lever = None
+    if setup.arm_angle is not None:
+        if cam is None:
+            raise ValueError("an oscillating follower's dynamics needs the cam (for the pivot's lever)")
+        lever = cam.state(motion.phi).lever
+    sampled = model(motion, alpha, rho, lever)
     phi = np.array(motion.phi, dtype=float)
     margin = dyn.min_contact_force
-    spring_preload = spring_from_spec(dyn).preload
+    spring_preload = _preload(setup)
 
     found = _extremes(model, sampled, phi, cam, margin=margin, omega=omega, preload=spring_preload)
     force_min, force_max, torque_min, torque_max, stress_max, need, flat_need, upper, lower = found
     preload = max(0.0, need.value)
+    if setup.arm_angle is not None and dyn.spring_arm is not None:
+        preload /= dyn.spring_arm  # the linear spring's force at its lever [N]
     deflection = preload / _rate(dyn) if dyn.uses_coil_spring and _rate(dyn) > 0.0 else None
     speeds = None
     if flat_need.value <= 0.0:
@@ -228,6 +280,7 @@ def analyse_dynamics(
         runs = ((force_min.phi % TWO_PI, force_min.phi % TWO_PI),)
     findings = _findings(
         dyn,
+        torsional=setup.arm_angle is not None and dyn.spring_arm is None,
         runs=runs,
         omega=omega,
         preload=preload,
@@ -251,6 +304,7 @@ def analyse_dynamics(
         margin=margin,
         jump_ranges=runs,
         min_preload=preload,
+        preload_unit="N·mm" if setup.arm_angle is not None and dyn.spring_arm is None else "N",
         preload_deflection=deflection,
         speed_range_rpm=speeds,
         allowable_stress=dyn.allowable_stress,
@@ -265,7 +319,7 @@ def analyse_dynamics(
 
 
 def _extremes(
-    model: Callable[[Motion, FloatArray, FloatArray], _Pointwise],
+    model: _Model,
     sampled: _Pointwise,
     phi: FloatArray,
     cam: Cam | None,
@@ -286,7 +340,7 @@ def _extremes(
 
     def quantity(p: FloatArray, side: Side) -> FloatArray:
         st = exact.state(p, side=side)
-        return rows(model(st.motion, st.pressure_angle, st.profile.rho))
+        return rows(model(st.motion, st.pressure_angle, st.profile.rho, st.lever))
 
     joints = [bp.phi for bp in cam.program.breakpoints]
     return extremes_rows(quantity, phi, joints, _KINDS, values=values)
@@ -295,6 +349,7 @@ def _extremes(
 def _findings(
     dyn: DynamicsSpec,
     *,
+    torsional: bool,
     runs: tuple[tuple[float, float], ...],
     omega: float,
     preload: float,
@@ -308,6 +363,7 @@ def _findings(
     findings: list[Finding] = []
     if runs:
         message = _jump_warning(
+            torsional=torsional,
             runs=runs,
             margin=margin,
             omega=omega,
@@ -316,7 +372,8 @@ def _findings(
             speeds=speeds,
             worst=force_min,
         )
-        findings.append(_limit("jump", "dynamics.spring_preload", message, force_min, margin, "N"))
+        field = "dynamics.spring_preload_torsional" if torsional else "dynamics.spring_preload"
+        findings.append(_limit("jump", field, message, force_min, margin, "N"))
     if dyn.allowable_stress is not None and stress_max.value > dyn.allowable_stress:
         message = (
             f"Hertz contact stress reaches {stress_max.value:.1f} MPa {stress_max.where()}, above the "

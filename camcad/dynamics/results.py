@@ -90,7 +90,8 @@ class DynamicsResult:
     guide_force_far: FloatArray | None = None
     margin: float = 0.0
     jump_ranges: tuple[tuple[float, float], ...] = ()
-    min_preload: float = 0.0
+    min_preload: float = 0.0  # in preload_unit
+    preload_unit: str = "N"  # "N·mm" for a torsion spring on an arm
     preload_deflection: float | None = None
     speed_range_rpm: tuple[float, float] | None = None
     allowable_stress: float | None = None
@@ -147,7 +148,7 @@ class DynamicsResult:
         out |= {
             "jump": self.jump,
             "jump_range_deg": None if arc is None else [_deg(arc[0]), _deg(arc[1])],
-            "min_preload_N": self.min_preload,
+            ("min_preload_N" if self.preload_unit == "N" else "min_preload_N_mm"): self.min_preload,
             "speed_range_rpm": None if self.speed_range_rpm is None else list(self.speed_range_rpm),
             "warnings": list(self.warnings),
         }

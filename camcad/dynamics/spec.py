@@ -44,6 +44,12 @@ class DynamicsSpec:
     follower_modulus: float = 206000.0  # MPa
     follower_poisson: float = 0.3
     allowable_stress: float | None = None  # MPa
+    # oscillating followers (energy method about the pivot)
+    arm_inertia: float = 0.0  # kg·mm², arm and roller about the pivot
+    spring_rate_torsional: float = 0.0  # N·mm/rad
+    spring_preload_torsional: float = 0.0  # N·mm at ψ = 0
+    spring_arm: float | None = None  # mm: a linear spring (spring_rate, spring_preload) at this lever
+    cg_distance: float = 0.0  # mm, the arm's centre of mass from the pivot (its weight is follower_mass)
 
     @property
     def uses_coil_spring(self) -> bool:
@@ -70,6 +76,10 @@ class DynamicsSetup:
     tappet_offset
         The guided tappet's axis offset [mm] as Hren et al. draw it (their
         Fig. 2 is a ccw cam): e for a ccw cam, −e for a cw cam, its mirror image.
+    arm_angle
+        Oscillating followers: the arm's direction at ψ = 0 in the machine
+        frame [rad] (pivot → roller centre, or along the face towards the cam);
+        None for a translating follower.
     """
 
     spec: DynamicsSpec
@@ -78,3 +88,4 @@ class DynamicsSetup:
     contact_length: float
     roller_radius: float = 0.0
     tappet_offset: float = 0.0
+    arm_angle: float | None = None

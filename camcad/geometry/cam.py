@@ -26,7 +26,13 @@ from camcad.geometry.envelope import (
     pressure_angle,
     to_cam,
 )
-from camcad.geometry.followers import Follower, TranslatingFlat, TranslatingRoller
+from camcad.geometry.followers import (
+    Follower,
+    OscillatingFlat,
+    OscillatingRoller,
+    TranslatingFlat,
+    TranslatingRoller,
+)
 from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
 from camcad.motion.program import Motion, MotionProgram, Side
 from camcad.motion.segments import SegmentSpec
@@ -78,7 +84,25 @@ def follower_from_spec(spec: FollowerSpec, base_radius: float) -> Follower:
         return TranslatingRoller(
             base_radius=base_radius, roller_radius=spec.roller_radius, eccentricity=spec.eccentricity
         )
-    return TranslatingFlat(base_radius=base_radius, eccentricity=spec.eccentricity)
+    if spec.kind is FollowerKind.OSCILLATING_ROLLER:
+        assert spec.pivot_distance is not None and spec.arm_length is not None  # the schema requires them
+        return OscillatingRoller(
+            base_radius=base_radius,
+            roller_radius=spec.roller_radius,
+            pivot_distance=spec.pivot_distance,
+            arm_length=spec.arm_length,
+        )
+    if spec.kind is FollowerKind.OSCILLATING_FLAT:
+        assert spec.pivot_distance is not None  # the schema requires it
+        return OscillatingFlat(
+            base_radius=base_radius,
+            pivot_distance=spec.pivot_distance,
+            face_offset=spec.face_offset,
+            face_width=spec.face_width,
+        )
+    return TranslatingFlat(
+        base_radius=base_radius, eccentricity=spec.eccentricity, face_width=spec.face_width
+    )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -86,15 +110,18 @@ class CamState:
     """The cam at some angles, from one evaluation (see :meth:`Cam.state`); arrays (n,) or (n, 2).
 
     ``base`` is the curve offsets are taken from: the pitch curve of a roller,
-    the profile of a face. ``contact_x`` is the contact's distance from the
-    follower axis along the machine's +x [mm] (see :meth:`Cam.contact_offset`).
+    the profile of a face. ``contact_position`` is where the contact sits on
+    the follower [mm] (see :meth:`Cam.contact_offset`). ``lever`` is an
+    oscillating follower's distance from its pivot to the driven point (roller
+    centre, or the contact on a face) [mm]; None for a slide.
     """
 
     motion: Motion
     base: CurveSample
     profile: CurveSample
     pressure_angle: FloatArray
-    contact_x: FloatArray
+    contact_position: FloatArray
+    lever: FloatArray | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -241,16 +268,21 @@ class Cam:
             base, drho = line_envelope(m.phi, element, self.sigma)
             profile = base
             driven = profile.point
-        alpha = pressure_angle(
-            m.phi, profile.normal, to_cam(m.phi, driven, -self.sigma), self.kinematics.guide, self.sigma
-        )
+        guide = self.kinematics.guide
+        driven_machine = to_cam(m.phi, driven, -self.sigma)
+        alpha = pressure_angle(m.phi, profile.normal, driven_machine, guide, self.sigma)
         contact = to_cam(m.phi, profile.point, -self.sigma)
+        lever = None
+        if guide.pivot is not None:
+            arm = driven_machine - np.asarray(guide.pivot)
+            lever = np.hypot(arm[:, 0], arm[:, 1])
         return CamState(
+            lever=lever,
             motion=m,
             base=base,
             profile=profile,
             pressure_angle=alpha,
-            contact_x=contact[:, 0] - self.eccentricity,
+            contact_position=self.kinematics.contact_position(contact, m),
         )
 
     def loop_radius(self, state: CamState) -> FloatArray:
@@ -280,14 +312,17 @@ class Cam:
         return pressure_angle(profile.phi, profile.normal, driven, self.kinematics.guide, self.sigma)
 
     def contact_offset(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
-        """Lateral distance of the contact from the follower axis [mm], along the machine's +x.
+        """Where the contact sits on the follower [mm] (:meth:`Follower.contact_position`).
 
-        For a flat face it is σ·v − e (Hren et al., eq. 27 with the
-        papers/README reading r_m = |ds/dφ|); for a roller it is the roller
-        radius times sin α, in the same sense.
+        Translating followers: its distance from the follower axis along the
+        machine's +x; for a flat face it is σ·v − e (Hren et al., eq. 27 with
+        the papers/README reading r_m = |ds/dφ|), for a roller the roller
+        radius times sin α, in the same sense. Oscillating flat face: its
+        distance B along the face from the pivot's foot.
         """
+        m = self.motion(phi, side=side)
         profile = self.profile(phi, side=side)
         contact = to_cam(profile.phi, profile.point, -self.sigma)
-        out = contact[:, 0] - self.eccentricity
+        out = self.kinematics.contact_position(contact, m)
         readonly(out)
         return out

@@ -61,7 +61,7 @@ class GeometryAnalysis:
     max_pressure_angle: float  # rad, the design limit
     undercut: Undercut | None
     findings: tuple[Finding, ...]
-    face_width_min: float | None  # mm, flat follower only: 2 × (largest contact excursion + margin)
+    face_width_min: float | None  # mm, flat faces: 2 × (excursion + margin); on an arm B_max + margin
     pressure_angle_max: Extreme  # of |α| [rad]
     profile_radius_min: Extreme  # polar radius of the contact point [mm]
     profile_radius_max: Extreme
@@ -163,6 +163,54 @@ def _pressure_finding(phi: FloatArray, alpha: FloatArray, worst: Extreme, limit:
     )
 
 
+def _arm_face_check(
+    reach_min: Extreme, reach_max: Extreme, face_width: float | None, face_margin: float
+) -> tuple[float, list[Finding]]:
+    """A face on an arm, reaching ``face_width`` from the pivot's foot, must hold [B_min, B_max] ± margin.
+
+    The contact's distance B along the face from the pivot's foot must stay
+    ≥ ``face_margin`` (else it runs off the face's pivot end) and ≤
+    ``face_width`` − ``face_margin``; the face length needed is B_max + margin.
+    """
+    needed = reach_max.value + face_margin
+    found: list[Finding] = []
+    if reach_min.value < face_margin:
+        found.append(
+            Finding(
+                kind="face width",
+                severity=Severity.HARD,
+                field="follower.pivot_distance",
+                message=(
+                    f"follower.pivot_distance: the contact comes within {reach_min.value:.3f} mm of the "
+                    f"pivot's foot on the face {reach_min.where()}, less than face_margin = "
+                    f"{face_margin:g} mm; move the pivot further from the cam or lower the lift"
+                ),
+                angle=reach_min.phi,
+                value=reach_min.value,
+                limit=face_margin,
+                unit="mm",
+            )
+        )
+    if face_width is not None and face_width < needed:
+        found.append(
+            Finding(
+                kind="face width",
+                severity=Severity.HARD,
+                field="follower.face_width",
+                message=(
+                    f"follower.face_width: {face_width:g} mm does not cover the contact, which reaches "
+                    f"{reach_max.value:.3f} mm along the face from the pivot's foot {reach_max.where()}; "
+                    f"with face_margin {face_margin:g} mm use face_width ≥ {_up(needed):.2f} mm"
+                ),
+                angle=reach_max.phi,
+                value=face_width,
+                limit=needed,
+                unit="mm",
+            )
+        )
+    return needed, found
+
+
 def _face_check(
     reach_min: Extreme, reach_max: Extreme, face_width: float | None, face_margin: float
 ) -> tuple[float, list[Finding]]:
@@ -238,7 +286,7 @@ def analyse_geometry(
         radius = np.hypot(st.profile.point[:, 0], st.profile.point[:, 1])
         rho = st.profile.rho
         undercut = cam.loop_radius(st)
-        x = st.contact_x
+        x = st.contact_position
         return np.vstack(
             (np.abs(st.pressure_angle), radius, radius, _convex(rho), _concave(rho), undercut, x, x)
         )
@@ -252,7 +300,8 @@ def analyse_geometry(
         findings.append(_pressure_finding(phi, alpha, alpha_max, max_pressure_angle))
     face_min = None
     if not roller:
-        face_min, found = _face_check(reach_min, reach_max, face_width, face_margin)
+        check = _face_check if cam.kinematics.guide.pivot is None else _arm_face_check
+        face_min, found = check(reach_min, reach_max, face_width, face_margin)
         findings += found
 
     quantity, limit = _undercut_quantity(cam)
@@ -358,7 +407,8 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
         way_out = "or use a smaller roller"
     else:
         what = (
-            f"cusp at {where}: the profile radius of curvature r_b + s + a falls to "
+            f"cusp at {where}: the profile radius of curvature "
+            f"{'r_b + s + a ' if cam.kinematics.guide.pivot is None else ''}falls to "
             f"{uc.worst:.3f} mm {uc.where()}"
         )
         way_out = "or use a gentler motion law"

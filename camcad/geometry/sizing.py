@@ -11,11 +11,13 @@ from camcad._typing import FloatArray
 from camcad.errors import DesignError
 from camcad.extremes import Extreme, Side, extremes_rows
 from camcad.geometry.cam import Cam
+from camcad.geometry.spec import arm_problem
 
-__all__ = ["SizingResult", "feasible_margins", "min_base_radius"]
+__all__ = ["SizingResult", "feasible_margins", "min_base_radius", "min_pivot_distance"]
 
 _RADIUS_TOL_MM = 1e-7
 _MAX_RADIUS_MM = 1e5
+_SCAN_POINTS = 96  # grid over an arm's admissible range before the bisection
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -27,12 +29,13 @@ class SizingResult:
     ``side`` when it is reached as a one-sided limit at a joint.
     """
 
-    base_radius: float
+    base_radius: float  # mm (the design's when the pivot distance was sized)
     limit: str
     angle: float
     side: Side | None  # the limit is reached just before ("left") or after ("right") a joint
     pressure_angle_max: float  # rad, at base_radius
     curvature_radius_min: float  # mm, smallest convex profile radius at base_radius
+    pivot_distance: float | None = None  # mm, oscillating followers: d at the result
 
 
 def feasible_margins(
@@ -100,6 +103,8 @@ def min_base_radius(
     is returned.
     """
     phi = cam.sample_phi(step)
+    if cam.follower.kind.oscillating:
+        return _arm_search(cam, phi, "base_radius", max_pressure_angle, min_curvature_radius)
     lo = max(abs(cam.eccentricity) - cam.roller_radius, 0.0) + _RADIUS_TOL_MM
 
     def at(radius: float) -> Cam:
@@ -155,4 +160,99 @@ def min_base_radius(
         side=worst.side,
         pressure_angle_max=max_pressure_angle - m_alpha,
         curvature_radius_min=m_rho + min_curvature_radius,
+    )
+
+
+def min_pivot_distance(
+    cam: Cam,
+    *,
+    max_pressure_angle: float = math.pi / 2,
+    min_curvature_radius: float = 0.0,
+    step: float | None = None,
+) -> SizingResult:
+    """The smallest pivot distance d [mm] of an oscillating follower meeting both limits, at the cam's r_b.
+
+    See :func:`min_base_radius` for the limits and :func:`_arm_search` for the search.
+    """
+    if not cam.follower.kind.oscillating:
+        raise DesignError("follower.type", "sizing the pivot distance needs an oscillating follower")
+    return _arm_search(cam, cam.sample_phi(step), "pivot_distance", max_pressure_angle, min_curvature_radius)
+
+
+def _arm_search(cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min: float) -> SizingResult:
+    """Smallest r_b or d of an oscillating follower meeting both limits at their true extremes.
+
+    For an arm neither limit is monotonic in r_b or d (the pressure angle at a
+    dwell is atan((d·cos β − l)/(d·sin β)), zero at one geometry and growing on
+    both sides of it), so the feasible set need not be a half-line: the search
+    scans the admissible range (the arm reaches the base circle and swings
+    clear, :func:`camcad.geometry.spec.arm_problem`) on a grid of
+    ``_SCAN_POINTS`` and bisects to 1e-7 mm between the last infeasible and the
+    first feasible grid value. Feasible sets narrower than the grid step are
+    not found (the error says so).
+    """
+    fol = cam.follower
+    swing = float(np.max(cam.motion(phi).s))
+    r_f = cam.roller_radius
+    d = fol.pivot_distance or 0.0
+    arm = fol.arm_length or 0.0
+    if knob == "base_radius":
+        hi = d - _RADIUS_TOL_MM
+        if fol.arm_length is not None:
+            hi = min(hi, d + arm - r_f)
+            lo = max(abs(d - arm) - r_f, 0.0)
+        else:
+            lo = 0.0
+    else:
+        r0 = cam.base_radius + r_f
+        lo = max(cam.base_radius, abs(r0 - arm) if fol.arm_length is not None else abs(cam.base_radius))
+        hi = r0 + arm if fol.arm_length is not None else 20.0 * (cam.base_radius + abs(fol.face_offset) + 1.0)
+
+    def make(x: float) -> Cam | None:
+        trial = (
+            replace(cam, base_radius=x)
+            if knob == "base_radius"
+            else replace(cam, follower=replace(fol, pivot_distance=x))
+        )
+        if arm_problem(trial.follower, trial.base_radius, swing) is not None:
+            return None
+        return trial
+
+    def ok(x: float) -> bool:
+        trial = make(x)
+        return trial is not None and _ok(trial, phi, alpha_max, rho_min)
+
+    previous = x = lo
+    for x in np.linspace(lo, hi, _SCAN_POINTS)[1:]:
+        if ok(float(x)):
+            break
+        previous = float(x)
+    else:
+        raise DesignError(
+            f"follower.{knob}" if knob == "pivot_distance" else "cam.max_pressure_angle",
+            f"no {knob} between {lo:.3f} and {hi:.3f} mm meets the limits (max pressure angle "
+            f"{math.degrees(alpha_max):g}°, min curvature radius {rho_min:g} mm) at this "
+            + ("pivot and arm" if knob == "base_radius" else "base radius"),
+        )
+    bad, good = previous, float(x)
+    while good - bad > _RADIUS_TOL_MM:
+        mid = 0.5 * (bad + good)
+        bad, good = (bad, mid) if ok(mid) else (mid, good)
+    best = make(good)
+    assert best is not None
+    m_alpha, m_rho, worst_alpha, worst_rho = feasible_margins(
+        best, phi, max_pressure_angle=alpha_max, min_curvature_radius=rho_min
+    )
+    alpha_binding = m_alpha / max(alpha_max, 1e-12) < m_rho / max(rho_min, 1.0)
+    limit, worst = ("pressure angle", worst_alpha) if alpha_binding else ("curvature", worst_rho)
+    if make(bad) is None:  # below the result the arm cannot be built at all
+        limit = "arm geometry (the arm must reach the base circle and swing clear)"
+    return SizingResult(
+        base_radius=best.base_radius,
+        limit=limit,
+        angle=worst.phi,
+        side=worst.side,
+        pressure_angle_max=alpha_max - m_alpha,
+        curvature_radius_min=m_rho + rho_min,
+        pivot_distance=best.follower.pivot_distance,
     )

@@ -11,8 +11,17 @@ and :class:`~camcad.geometry.cam.Cam`. See the README's "Adding a follower".
 
 from __future__ import annotations
 
-from camcad.geometry.followers.base import Follower
+from camcad.geometry.followers.base import Follower, FollowerSketch
+from camcad.geometry.followers.oscillating_flat import OscillatingFlat
+from camcad.geometry.followers.oscillating_roller import OscillatingRoller
 from camcad.geometry.followers.translating_flat import TranslatingFlat
 from camcad.geometry.followers.translating_roller import TranslatingRoller
 
-__all__ = ["Follower", "TranslatingFlat", "TranslatingRoller"]
+__all__ = [
+    "Follower",
+    "FollowerSketch",
+    "OscillatingFlat",
+    "OscillatingRoller",
+    "TranslatingFlat",
+    "TranslatingRoller",
+]

@@ -7,8 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, LineElement, PointElement
-from camcad.geometry.followers.base import slide_point
+from camcad.geometry.followers.base import FollowerSketch, slide_point, slide_sketch
 from camcad.motion.program import Motion
 
 __all__ = ["TranslatingFlat"]
@@ -25,6 +26,7 @@ class TranslatingFlat:
 
     base_radius: float  # r_b [mm]
     eccentricity: float = 0.0  # e [mm]: the slide's axis is the line x = e
+    face_width: float | None = None  # mm, centred on the slide's axis (drawings)
 
     @property
     def roller_radius(self) -> float:
@@ -52,3 +54,15 @@ class TranslatingFlat:
     def describe(self) -> str:
         """E.g. ``"translating flat face, e = 0 mm"``."""
         return f"translating flat face, e = {self.eccentricity:g} mm"
+
+    def contact_position(self, contact: FloatArray, motion: Motion) -> FloatArray:
+        """X − e [mm]: the contact's distance from the slide's axis (σ·v − e, Hren et al. eq. 27)."""
+        out: FloatArray = contact[:, 0] - self.eccentricity
+        return out
+
+    def sketch(self, motion: Motion, *, size: float) -> list[FollowerSketch]:
+        """Face, stem along +y and the slide's axis, at each angle."""
+        half = 0.5 * self.face_width if self.face_width else 0.6 * size
+        centres = self.trace(motion).m0
+        axis = np.array([0.0, 1.0])
+        return [slide_sketch(c, axis, radius=0.0, half_face=half, size=size) for c in centres]

@@ -5,8 +5,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
+from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, PointElement
-from camcad.geometry.followers.base import slide_point
+from camcad.geometry.followers.base import FollowerSketch, slide_point, slide_sketch
 from camcad.motion.program import Motion
 
 __all__ = ["TranslatingRoller"]
@@ -45,3 +48,14 @@ class TranslatingRoller:
     def describe(self) -> str:
         """E.g. ``"translating roller, r_f = 15 mm, e = 20 mm"``."""
         return f"translating roller, r_f = {self.roller_radius:g} mm, e = {self.eccentricity:g} mm"
+
+    def contact_position(self, contact: FloatArray, motion: Motion) -> FloatArray:
+        """X − e [mm]: the contact's distance from the slide's axis (r_f·sin α)."""
+        out: FloatArray = contact[:, 0] - self.eccentricity
+        return out
+
+    def sketch(self, motion: Motion, *, size: float) -> list[FollowerSketch]:
+        """Roller circle, stem along +y and the slide's axis, at each angle."""
+        centres = self.element(motion).m0
+        axis = np.array([0.0, 1.0])
+        return [slide_sketch(c, axis, radius=self.roller_radius, half_face=0.0, size=size) for c in centres]

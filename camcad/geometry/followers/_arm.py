@@ -1,0 +1,43 @@
+"""What the two oscillating followers share: the arm angle ψ(φ) and points turning about a pivot."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from camcad._typing import FloatArray
+from camcad.geometry.envelope import PointElement
+from camcad.motion.program import Motion
+
+__all__ = ["arm_swing", "turning_point"]
+
+ArmAngles = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
+
+
+def arm_swing(motion: Motion) -> ArmAngles:
+    """ψ [rad] and ψ′, ψ″, ψ‴ [rad/radᵏ]: an oscillating follower's lift is an angle given in degrees."""
+    k = math.pi / 180.0
+    return (
+        np.asarray(motion.s, dtype=float) * k,
+        np.asarray(motion.v, dtype=float) * k,
+        np.asarray(motion.a, dtype=float) * k,
+        np.asarray(motion.j, dtype=float) * k,
+    )
+
+
+def turning_point(pivot: tuple[float, float], length: float, theta: ArmAngles) -> PointElement:
+    """The point P + l·e(θ) at distance l [mm] from the pivot P, at angle θ(φ), with three φ-derivatives.
+
+    With e = (cos θ, sin θ) and J e its quarter turn: M′ = lθ′Je,
+    M″ = l(θ″Je − θ′²e), M‴ = l((θ‴ − θ′³)Je − 3θ′θ″e).
+    """
+    t0, t1, t2, t3 = theta
+    e = np.column_stack((np.cos(t0), np.sin(t0)))
+    je = np.column_stack((-e[:, 1], e[:, 0]))
+    return PointElement(
+        m0=np.asarray(pivot, dtype=float) + length * e,
+        m1=length * t1[:, None] * je,
+        m2=length * (t2[:, None] * je - (t1**2)[:, None] * e),
+        m3=length * ((t3 - t1**3)[:, None] * je - (3.0 * t1 * t2)[:, None] * e),
+    )

@@ -1,0 +1,115 @@
+"""Oscillating (swinging-arm) roller follower."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from camcad._typing import FloatArray
+from camcad.geometry.envelope import Guide, PointElement
+from camcad.geometry.followers._arm import arm_swing, turning_point
+from camcad.geometry.followers.base import FollowerSketch, circle_points
+from camcad.motion.program import Motion
+
+__all__ = ["OscillatingRoller"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class OscillatingRoller:
+    """A roller of radius r_f on an arm of length l that swings about a pivot at distance d from the cam axis.
+
+    Convention: at φ = 0 (ψ = 0) the roller centre stands on the +y axis at
+    r_b + r_f from the cam axis and the pivot lies to its right (x > 0). The
+    arm angle β (at the pivot, from the line pivot → cam axis to the arm) is
+    β = β0 + ψ with cos β0 = (d² + l² − (r_b + r_f)²)/(2dl) (Rothbart 2004,
+    §5.3; Chen 1982, eq. 6-12): a rise (ψ growing) swings the roller away from
+    the cam axis, which turns the arm clockwise in the machine frame.
+    """
+
+    base_radius: float  # r_b [mm]
+    roller_radius: float  # r_f [mm]
+    pivot_distance: float  # d [mm]
+    arm_length: float  # l [mm]
+
+    @property
+    def prime_radius(self) -> float:
+        """r_b + r_f [mm]: the roller centre's distance from the cam axis at ψ = 0."""
+        return self.base_radius + self.roller_radius
+
+    @property
+    def pivot(self) -> tuple[float, float]:
+        """The pivot (x > 0, y) [mm], machine frame: |pivot| = d, |pivot − (0, r_b + r_f)| = l."""
+        r0, d, arm = self.prime_radius, self.pivot_distance, self.arm_length
+        y = (d * d - arm * arm + r0 * r0) / (2.0 * r0)
+        return (math.sqrt(max(d * d - y * y, 0.0)), y)
+
+    @property
+    def initial_arm_angle(self) -> float:
+        """β0 [rad]: the arm's angle from the line pivot → cam axis at ψ = 0 (law of cosines)."""
+        r0, d, arm = self.prime_radius, self.pivot_distance, self.arm_length
+        return math.acos(max(-1.0, min(1.0, (d * d + arm * arm - r0 * r0) / (2.0 * d * arm))))
+
+    @property
+    def arm_direction(self) -> float:
+        """The arm's direction pivot → roller centre at ψ = 0, machine frame [rad]."""
+        px, py = self.pivot
+        return math.atan2(self.prime_radius - py, -px)
+
+    def arm_angle(self, motion: Motion) -> FloatArray:
+        """β = β0 + ψ [rad] at the motion's angles."""
+        out: FloatArray = self.initial_arm_angle + arm_swing(motion)[0]
+        return out
+
+    @property
+    def guide(self) -> Guide:
+        """The pivot; a growing ψ turns the arm clockwise."""
+        return Guide(pivot=self.pivot, turn=-1.0)
+
+    def element(self, motion: Motion) -> PointElement:
+        """The roller centre P + l·e(θ), θ = γ − β0 − ψ with γ the direction pivot → cam axis."""
+        px, py = self.pivot
+        gamma = math.atan2(-py, -px)
+        psi, d1, d2, d3 = arm_swing(motion)
+        return turning_point(
+            self.pivot, self.arm_length, (gamma - self.initial_arm_angle - psi, -d1, -d2, -d3)
+        )
+
+    def trace(self, motion: Motion) -> PointElement:
+        """The roller centre: the element itself."""
+        return self.element(motion)
+
+    def describe(self) -> str:
+        """E.g. ``"oscillating roller, r_f = 15 mm, d = 120 mm, l = 90 mm"``."""
+        return (
+            f"oscillating roller, r_f = {self.roller_radius:g} mm, d = {self.pivot_distance:g} mm, "
+            f"l = {self.arm_length:g} mm"
+        )
+
+    def contact_position(self, contact: FloatArray, motion: Motion) -> FloatArray:
+        """The contact's signed distance from the arm's line [mm] (r_f·sin α; + to the arm's left)."""
+        centre = self.element(motion).m0
+        arm = centre - np.asarray(self.pivot)
+        unit = arm / np.hypot(arm[:, 0], arm[:, 1])[:, None]
+        rel = contact - centre
+        out: FloatArray = unit[:, 0] * rel[:, 1] - unit[:, 1] * rel[:, 0]
+        return out
+
+    def sketch(self, motion: Motion, *, size: float) -> list[FollowerSketch]:
+        """Roller, arm from the pivot to the roller centre, and the pivot, at each angle."""
+        pivot = np.asarray(self.pivot)
+        out = []
+        for centre in self.element(motion).m0:
+            radial = centre / np.hypot(*centre)  # the label goes outward, beyond the roller
+            out.append(
+                FollowerSketch(
+                    body=(circle_points(centre, self.roller_radius),),
+                    links=(np.array([pivot, centre]),),
+                    axes=(),
+                    marks=np.array([centre, pivot]),
+                    tip=centre + (self.roller_radius + 0.05 * size) * radial,
+                    heading=radial,
+                )
+            )
+        return out
