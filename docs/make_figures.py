@@ -2,6 +2,8 @@
 
 - ``docs/hren_torque.png``: the drive torque of the Hren et al. Table 1 tappet
   cam over the stroke (003 eq. 29), from ``samples/hren_tappet.toml``.
+- ``docs/oscillating.png``: the oscillating followers' convention at φ = 0,
+  drawn from the follower modules of the two oscillating samples.
 - The Quintero & Vanegas (2016) section 5 table, printed as Markdown.
 """
 
@@ -73,6 +75,74 @@ def quintero_table() -> None:
         )
 
 
+def oscillating_convention() -> None:
+    """Roller and flat face on an arm at φ = 0: base circle, roller/face, pivot, d, l, β0, the rise's sense."""
+    from camcad.geometry import Cam
+
+    fig = Figure(figsize=(10.0, 4.8), dpi=110)
+    FigureCanvasAgg(fig)
+    for k, stem in enumerate(("packaging_rocker", "rocker_flat")):
+        cam = Cam.from_design(load_design(ROOT / "samples" / f"{stem}.toml"))
+        follower = cam.kinematics
+        ax = fig.add_subplot(1, 2, k + 1)
+        t = np.linspace(0, 2 * np.pi, 200)
+        rb = cam.base_radius
+        ax.plot(rb * np.cos(t), rb * np.sin(t), color="0.5", ls=":", lw=1)
+        ax.plot(0, 0, "k+", ms=10)
+        sketch = follower.sketch(cam.motion(np.array([0.0])), size=rb)[0]
+        for part in sketch.body:
+            ax.plot(*part.T, color="#1f4e79", lw=2)
+        for part in sketch.links:
+            ax.plot(*part.T, color="#c0392b", lw=2)
+        px, py = follower.guide.pivot
+        ax.plot(px, py, "o", color="#c0392b", ms=6)
+        ax.plot([0, px], [0, py], color="0.3", lw=0.8, ls="--")
+        ax.annotate("pivot", (px, py), textcoords="offset points", xytext=(6, 6))
+        ax.annotate(
+            f"d = {cam.follower.pivot_distance:g}",
+            (px / 2, py / 2),
+            textcoords="offset points",
+            xytext=(4, -14),
+        )
+        if cam.is_roller:
+            centre = follower.element(cam.motion(np.array([0.0]))).m0[0]
+            ax.annotate(
+                f"l = {cam.follower.arm_length:g}",
+                (centre + np.array([px, py])) / 2,
+                textcoords="offset points",
+                xytext=(-10, -18),
+            )
+            ax.annotate(
+                "roller centre on +y\nat r_b + r_f", centre, textcoords="offset points", xytext=(-110, 10)
+            )
+            title = "oscillating-roller: β = β0 + ψ, a rise swings the roller outward"
+        else:
+            ax.annotate(
+                "face tangent to the base circle at (0, r_b)",
+                (0, rb),
+                textcoords="offset points",
+                xytext=(-90, -28),
+            )
+            title = f"oscillating-flat: face {cam.follower.face_offset:g} mm below the pivot, a rise lifts it"
+        # the sense of a rise: the arm turns clockwise about the pivot
+        ax.annotate(
+            "",
+            xy=(px - 18, py + 12),
+            xytext=(px - 22, py - 6),
+            arrowprops={"arrowstyle": "->", "color": "#c0392b", "connectionstyle": "arc3,rad=-0.4"},
+        )
+        ax.text(px - 30, py + 16, "rise", color="#c0392b", fontsize=8)
+        ax.margins(0.15)
+        ax.set_title(title, fontsize=9)
+        ax.set_aspect("equal")
+        ax.grid(alpha=0.3)
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+    fig.tight_layout()
+    fig.savefig(ROOT / "docs" / "oscillating.png")
+
+
 if __name__ == "__main__":
+    oscillating_convention()
     hren_torque()
     quintero_table()
