@@ -129,6 +129,13 @@ def _motion_plot(analysis: Analysis) -> Plot:
         (m.a, "a = d²s/dφ² [mm/rad²]", "acceleration"),
         (m.j, "j = d³s/dφ³ [mm/rad³]", "jerk"),
     )
+    if analysis.cam.follower.kind.oscillating:  # an arm's lift is its swing ψ, in degrees
+        series = (
+            (m.s, "ψ [°]", "arm angle"),
+            (m.v, "ψ′ = dψ/dφ [°/rad]", "angular velocity"),
+            (m.a, "ψ″ = d²ψ/dφ² [°/rad²]", "angular acceleration"),
+            (m.j, "ψ‴ = d³ψ/dφ³ [°/rad³]", "angular jerk"),
+        )
     for k, (ax, (values, label, _)) in enumerate(zip(axes, series, strict=True)):
         x, y = _closed(np.degrees(m.phi), np.asarray(values))
         ax.plot(x, y, color=_COLORS[k], linewidth=1.3)

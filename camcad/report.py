@@ -276,9 +276,7 @@ def _card(label: str, value: str, note: str = "", *, over: bool = False) -> str:
 
 def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
     cam = analysis.cam
-    follower = f"roller r = {cam.roller_radius:g} mm" if cam.is_roller else "flat-face follower"
-    if cam.eccentricity:
-        follower += f", offset {cam.eccentricity:g} mm"
+    follower = cam.kinematics.describe()
     alpha_over = k["alpha"] > k["alpha_limit"]
     alpha_note = f"limit {k['alpha_limit']:.2f}°"
     if k["alpha_at"] is not None:
@@ -306,7 +304,9 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
             f"max error {_num(k['fit_error'], '.3g')} mm (tolerance {_num(k['fit_tolerance'], 'g')} mm)",
         )
     cards = [
-        _card("Lift", f"{k['lift']:.3f} mm"),
+        _card("Arm swing", f"{k['lift']:.3f}°")
+        if cam.follower.kind.oscillating
+        else _card("Lift", f"{k['lift']:.3f} mm"),
         _card("Base radius", f"{cam.base_radius:.3f} mm", follower),
         _card("Max pressure angle", f"{k['alpha']:.2f}°", alpha_note, over=alpha_over),
         _card("Min curvature radius", f"{_num(k['rho'], '.3f')} mm", rho_note),
@@ -340,7 +340,8 @@ def _program_table(analysis: Analysis) -> str:
                 _e(law),
             ]
         )
-    header = ["#", "segment", "start [°]", "span [°]", "lift [mm]", "law"]
+    lift = "lift [°]" if analysis.cam.follower.kind.oscillating else "lift [mm]"
+    header = ["#", "segment", "start [°]", "span [°]", lift, "law"]
     return _table(header, rows)
 
 
@@ -350,8 +351,9 @@ def _design_table(analysis: Analysis) -> str:
     rows = [
         ("follower", design.follower.kind.value),
         ("base radius [mm]", _num(spec.base_radius)),
+        ("follower", _e(cam.kinematics.describe())),
         ("roller radius [mm]", _num(cam.roller_radius) if cam.is_roller else _DASH),
-        ("follower offset [mm]", _num(cam.eccentricity)),
+        ("follower offset [mm]", _num(cam.eccentricity) if not cam.follower.kind.oscillating else _DASH),
         ("rotation", spec.rotation.value),
         ("speed [rpm]", _num(spec.speed_rpm)),
         ("thickness [mm]", _num(spec.thickness)),
