@@ -11,11 +11,35 @@ curve for export.
 
 from __future__ import annotations
 
-from camcad.fit._profile import fit_points, fit_profile
-from camcad.fit.bspline import clamped_from_periodic, to_geomdl
-from camcad.fit.cam import fit_cam_profile
-from camcad.fit.curve import BSplineCurve
-from camcad.fit.result import ProfileFit
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from camcad.fit._profile import fit_points, fit_profile
+    from camcad.fit.bspline import clamped_from_periodic, to_geomdl
+    from camcad.fit.cam import fit_cam_profile
+    from camcad.fit.curve import BSplineCurve
+    from camcad.fit.result import ProfileFit
+
+_HOME = {
+    "BSplineCurve": "camcad.fit.curve",
+    "ProfileFit": "camcad.fit.result",
+    "clamped_from_periodic": "camcad.fit.bspline",
+    "fit_cam_profile": "camcad.fit.cam",
+    "fit_points": "camcad.fit._profile",
+    "fit_profile": "camcad.fit._profile",
+    "to_geomdl": "camcad.fit.bspline",
+}
+"""Where each public name lives: loaded on first use, so ``camcad.fit.spec`` (read by
+``camcad.design``) does not load SciPy."""
+
+
+def __getattr__(name: str) -> object:
+    """Import a public name's module on first use (PEP 562)."""
+    if name in _HOME:
+        return getattr(importlib.import_module(_HOME[name]), name)
+    raise AttributeError(f"module 'camcad.fit' has no attribute {name!r}")
+
 
 __all__ = [
     "BSplineCurve",

@@ -24,15 +24,46 @@ turns a :class:`Toolpath` into G-code text.
 ...     ],
 ... })
 >>> cam = Cam.from_design(design)
+>>> from camcad.toolpath import plan_toolpath
 >>> toolpath = plan_toolpath(cam, design.gcode, name="demo", thickness=design.cam.thickness)
 >>> toolpath.max_deviation <= design.gcode.tolerance
 True
 """
 
-from camcad.toolpath.arcs import Pieces, biarc_pieces, fit_arc_spline, measure_deviation
-from camcad.toolpath.moves import Move, MoveKind
-from camcad.toolpath.plan import RAPID_RATE, Toolpath, plan_toolpath
-from camcad.toolpath.verify import ToolpathCheck, check_toolpath
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from camcad.toolpath.arcs import Pieces, biarc_pieces, fit_arc_spline, measure_deviation
+    from camcad.toolpath.moves import Move, MoveKind
+    from camcad.toolpath.plan import RAPID_RATE, Toolpath, plan_toolpath
+    from camcad.toolpath.verify import ToolpathCheck, check_toolpath
+
+_HOME = {
+    "Pieces": "camcad.toolpath.arcs",
+    "biarc_pieces": "camcad.toolpath.arcs",
+    "fit_arc_spline": "camcad.toolpath.arcs",
+    "measure_deviation": "camcad.toolpath.arcs",
+    "Move": "camcad.toolpath.moves",
+    "MoveKind": "camcad.toolpath.moves",
+    "RAPID_RATE": "camcad.toolpath.plan",
+    "Toolpath": "camcad.toolpath.plan",
+    "plan_toolpath": "camcad.toolpath.plan",
+    "ToolpathCheck": "camcad.toolpath.verify",
+    "check_toolpath": "camcad.toolpath.verify",
+}
+"""Where each public name lives: loaded on first use, so ``camcad.toolpath.spec`` (read by
+``camcad.design`` for every design) loads neither the planner nor the verifier (SciPy)."""
+
+
+def __getattr__(name: str) -> object:
+    """Import a public name's module on first use (PEP 562)."""
+    if name in _HOME:
+        return getattr(importlib.import_module(_HOME[name]), name)
+    raise AttributeError(f"module 'camcad.toolpath' has no attribute {name!r}")
+
 
 __all__ = [
     "RAPID_RATE",

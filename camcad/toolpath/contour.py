@@ -17,7 +17,7 @@ import numpy as np
 from camcad._typing import FloatArray
 from camcad.errors import DesignLimitError
 from camcad.geometry.cam import Cam
-from camcad.toolpath.arcs.biarc import CurveFn, Pieces, measure_deviation
+from camcad.toolpath.arcs.biarc import CurveFn, Pieces, cross, measure_deviation, offset_pieces
 from camcad.toolpath.arcs.spline import fit_arc_spline
 from camcad.toolpath.moves import MoveKind
 
@@ -27,6 +27,7 @@ __all__ = [
     "Contour",
     "Step",
     "fit_contour",
+    "offset_contour",
     "offset_curve",
     "round_mm",
     "round_point",
@@ -80,6 +81,8 @@ class Contour:
     start_tangent: tuple[float, float]  # unit, travel direction
     end_tangent: tuple[float, float]
     normal: tuple[float, float]  # outward at the start
+    distance: float  # mm: the offset from the profile this contour follows
+    pieces: Pieces  # the fitted pieces before rounding, in φ order
 
 
 def _signed_area(pieces: Pieces) -> float:
@@ -258,6 +261,54 @@ def fit_contour(
         pieces, _ = fit_arc_spline(curve, breaks, fit_tol, arcs=arcs, nodes=edges)
     except ValueError as err:  # pragma: no cover - only for a cusp the gouge check missed
         raise DesignLimitError(f"cannot fit the toolpath: {err}") from err
+    return _realise(cam, distance, pieces, breaks, tol, clockwise=clockwise, windows=windows)
+
+
+def offset_contour(
+    cam: Cam,
+    base: Contour,
+    distance: float,
+    breaks: FloatArray,
+    tol: float,
+    fit_tol: float,
+    *,
+    clockwise: bool,
+    windows: Sequence[tuple[float, float]] = (),
+) -> Contour:
+    """The closed path ``cam.offset(phi, distance)`` as the offset of another contour's arc spline.
+
+    ``base`` is an arc-spline contour of the same cam fitted with the same
+    ``breaks`` and ``windows``; its pieces are offset by
+    ``distance − base.distance`` outward (arcs stay arcs: same centres, radii changed
+    by the offset) and measured two-way against the exact curve. Where
+    every interval is within ``fit_tol`` they are used, so the contour has
+    as many pieces as ``base`` and its tolerance certificate is measured
+    like a fitted one's; otherwise (an arc that would turn inside out, or a
+    piece out of tolerance) the curve is fitted afresh with
+    :func:`fit_contour`. Offsetting takes milliseconds where a fit takes a
+    search (the roughing contour of :func:`camcad.toolpath.plan_toolpath`).
+    """
+    curve = offset_curve(cam, distance)
+    at = cam.offset(np.array([breaks[0]]), base.distance)
+    left = float(np.sign(cross(at.tangent[0], at.normal[0])))  # +1: outward is left of increasing φ
+    moved = offset_pieces(base.pieces, left * (distance - base.distance))
+    if moved is not None and float(measure_deviation(curve, moved).max()) <= fit_tol:
+        return _realise(cam, distance, moved, breaks, tol, clockwise=clockwise, windows=windows)
+    return fit_contour(cam, distance, breaks, tol, fit_tol, clockwise=clockwise, windows=windows)
+
+
+def _realise(
+    cam: Cam,
+    distance: float,
+    pieces: Pieces,
+    breaks: FloatArray,
+    tol: float,
+    *,
+    clockwise: bool,
+    windows: Sequence[tuple[float, float]],
+) -> Contour:
+    """Orient, round, measure, merge and split the pieces of ``cam.offset(phi, distance)`` into a contour."""
+    curve = offset_curve(cam, distance)
     reverse = (_signed_area(pieces) > 0.0) == clockwise
     steps, real = _emit(pieces, reverse=reverse, tol=tol)
     dev = float(measure_deviation(curve, real, samples=48).max())
@@ -279,4 +330,6 @@ def fit_contour(
         start_tangent=(float(t_start[0]), float(t_start[1])),
         end_tangent=(float(t_end[0]), float(t_end[1])),
         normal=(float(o.normal[0, 0]), float(o.normal[0, 1])),
+        distance=distance,
+        pieces=pieces,
     )

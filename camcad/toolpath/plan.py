@@ -29,7 +29,8 @@ from camcad._typing import FloatArray
 from camcad.errors import DesignError, DesignLimitError
 from camcad.geometry.cam import Cam
 from camcad.geometry.tool import check_tool
-from camcad.toolpath.contour import LINE_SAGITTA, Contour, fit_contour, round_mm
+from camcad.toolpath.arcs.biarc import norm2
+from camcad.toolpath.contour import LINE_SAGITTA, Contour, fit_contour, offset_contour, round_mm
 from camcad.toolpath.moves import Move, MoveKind, path_length
 from camcad.toolpath.passes import Program, check_bore, cut_contour, lead_points, mill_bore
 from camcad.toolpath.spec import Direction, GcodeSpec
@@ -74,6 +75,9 @@ class Toolpath:
         Blocks in one finishing contour (leads excluded).
     notes
         Remarks for the header (e.g. a keyway left for another operation).
+    operation
+        ``"profile"`` (a plate's outline, cut through) or ``"groove"`` (a
+        groove cam's slot and flank passes, :func:`camcad.toolpath.groove.plan_groove`).
     """
 
     name: str
@@ -88,6 +92,7 @@ class Toolpath:
     max_deviation: float
     contour_blocks: int
     notes: tuple[str, ...] = ()
+    operation: str = "profile"
 
     @property
     def tool_radius(self) -> float:
@@ -183,7 +188,7 @@ def _lead_radius(
     radius = wanted
     while radius >= 0.1 * wanted:
         pts = np.asarray(lead_points(contour, radius))
-        gap = np.min(np.linalg.norm(pts[:, None, :] - profile[None, :, :], axis=2), axis=1)
+        gap = np.min(norm2(pts[:, None, :] - profile[None, :, :]), axis=1)
         if gap.min() >= distance - tol:
             return radius
         radius /= 1.25
@@ -346,7 +351,12 @@ def _fit_contours(
     breaks = _breaks(cam, phi0)
     clockwise = spec.direction is Direction.CLIMB
     finish = fit_contour(cam, r, breaks, tol, fit_tol, clockwise=clockwise, windows=windows, arcs=arcs)
-    if stock > 0.0:
+    if stock > 0.0 and arcs:
+        # the finishing arc spline offset by the stock (arcs stay arcs), measured; refitted if it misses
+        rough = offset_contour(
+            cam, finish, r + stock, breaks, tol, fit_tol, clockwise=clockwise, windows=windows
+        )
+    elif stock > 0.0:  # chords offset apart at their corners: fit them afresh
         rough = fit_contour(
             cam, r + stock, breaks, tol, fit_tol,
             clockwise=clockwise, windows=windows, arcs=arcs,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from functools import cache
 
 import numpy as np
 import pytest
@@ -17,6 +18,7 @@ from camcad.toolpath.arcs.biarc import (
     biarc_pieces,
     chord_pieces,
     measure_deviation,
+    offset_pieces,
     sample_pieces,
 )
 from camcad.toolpath.arcs.search import search_arcs
@@ -231,3 +233,61 @@ def test_other_errors_of_the_search_are_not_taken_for_a_stall(monkeypatch):
     monkeypatch.setattr(spline, "search_arcs", broken)
     with pytest.raises(ValueError, match="not a stall"):
         fit_arc_spline(wobble(), np.linspace(0.0, 2 * np.pi, 5), 0.004)
+
+
+def chain_points(pieces):
+    """Dense points along every non-empty piece (chord sagitta below 1e-6 mm)."""
+    samples = sample_pieces(pieces, 400)
+    lengths = pieces.length()
+    return np.vstack(
+        [
+            np.stack([pieces.start[i, k], *samples[i, k], pieces.end[i, k]])
+            for i in range(len(pieces))
+            for k in (0, 1)
+            if lengths[i, k] > 0.0
+        ]
+    )
+
+
+@cache
+def ellipse_spline(a: float, b: float):
+    pieces, _ = fit_arc_spline(ellipse(a, b), np.linspace(0.0, 2 * np.pi, 5), 0.004)
+    return pieces
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    axes=st.sampled_from([(60.0, 35.0), (45.0, 40.0), (30.0, 25.0)]),
+    delta=st.floats(-3.0, 3.0).filter(lambda d: abs(d) > 1e-3),
+)
+def test_offset_arc_spline_is_the_parallel_curve_with_as_many_pieces(axes, delta):
+    # against the definition of a parallel curve: every point of the offset chain lies at |δ| from the
+    # original chain and every point of the original at |δ| from the offset (both measured on dense
+    # polylines with a k-d tree), and the chain stays one closed connected path
+    pieces = ellipse_spline(*axes)
+    moved = offset_pieces(pieces, delta)
+    assert moved is not None
+    assert len(moved) == len(pieces)
+    assert_allclose(moved.end[:-1, 1], moved.start[1:, 0], atol=1e-9)
+    assert_allclose(moved.end[:, 0], moved.start[:, 1], atol=1e-9)
+    assert_allclose(moved.end[-1, 1], moved.start[0, 0], atol=1e-9)
+    old, new = chain_points(pieces), chain_points(moved)
+    assert_allclose(dense_distance(new, old), abs(delta), atol=2e-6)
+    assert_allclose(dense_distance(old, new), abs(delta), atol=2e-6)
+    # δ moves to the left of travel; the ellipse runs counter-clockwise, so δ > 0 moves inward
+    assert (shoelace(new) < shoelace(old)) == (delta > 0.0)
+
+
+def shoelace(p):
+    """Signed area enclosed by a closed polyline (n, 2)."""
+    return 0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+
+
+def test_offset_that_would_turn_an_arc_inside_out_is_refused():
+    # a circle of radius 10 run counter-clockwise: its centre is on the left, 10 mm away
+    pieces, _ = fit_arc_spline(ellipse(10.0, 10.0), np.linspace(0.0, 2 * np.pi, 5), 1e-4)
+    assert offset_pieces(pieces, 10.0) is None
+    inner = offset_pieces(pieces, 9.9)
+    assert inner is not None
+    assert_allclose(inner.r_start[~inner.line], 0.1, atol=1e-9)
+    assert_allclose(inner.center.reshape(-1, 2)[~inner.line.ravel()], 0.0, atol=1e-9)

@@ -19,8 +19,9 @@ from camcad.errors import DesignError, DesignLimitError, GougeError
 from camcad.export.gcode import parse_gcode, render_gcode
 from camcad.geometry.cam import Cam
 from camcad.geometry.tool import check_tool
-from camcad.toolpath import MoveKind, Toolpath, check_toolpath, plan_toolpath
+from camcad.toolpath import MoveKind, Toolpath, check_toolpath, contour, plan_toolpath
 from camcad.toolpath.contour import Step, split_tabs
+from camcad.toolpath.verify import densify, distance_to_polyline
 from tests.conftest import SAMPLES, make_design
 
 CONFIGS = {
@@ -65,6 +66,59 @@ def test_parsed_program_passes_the_geometric_proof(config):
     assert check.direction is design.gcode.direction
     assert not check.missing_levels
     assert check.low_rapids == 0
+
+
+def profile_passes(tp: Toolpath) -> list[list]:
+    """The profile passes of a program: runs of feed moves between rapids that hold arcs outside the bore."""
+    runs, cur = [], []
+    for m in tp.moves:
+        if m.kind is MoveKind.RAPID:
+            runs.append(cur)
+            cur = []
+        else:
+            cur.append(m)
+    runs.append(cur)
+    bore = tp.bore / 2.0 + 1e-6
+    return [r for r in runs if r and any(math.hypot(*m.end[:2]) > bore for m in r if m.kind.is_arc)]
+
+
+@pytest.mark.parametrize("config", [c for c in ALL if c != "start-75-no-stock"])
+def test_roughing_contour_is_within_tolerance_of_its_own_exact_offset(config):
+    # the roughing contour is the finishing arc spline offset by the stock (issue 18); measured here
+    # against the exact curve cam.offset(φ, r + stock), two-way, on dense samples of both (the
+    # exact curve at 200 000 φ, the moves every 0.02 mm), leads excluded
+    design, cam, tp = planned(config)
+    *rough, finish = profile_passes(tp)
+    assert rough and tp.rough_offset > design.gcode.tool_radius
+    planar = [m for m in rough[-1] if m.kind.is_arc or m.start[:2] != m.end[:2]][1:-1]
+    path = np.vstack([densify(m) for m in planar])[:, :2]
+    exact = np.asarray(cam.offset(np.linspace(0.0, 2.0 * math.pi, 200_001), tp.rough_offset).point)
+    tol = design.gcode.tolerance
+    assert distance_to_polyline(path, exact).max() <= tol
+    assert distance_to_polyline(exact[::4], path).max() <= tol
+    # as many blocks as the finishing contour, whose arcs it offsets
+    finish_planar = [m for m in finish if m.kind.is_arc or m.start[:2] != m.end[:2]][1:-1]
+    assert len(planar) == len(finish_planar)
+
+
+def test_roughing_contour_is_fitted_afresh_when_the_offset_spline_cannot_be_used(monkeypatch):
+    # an offset that would turn an arc inside out (or miss the tolerance) falls back to the arc search
+    design = design_for("climb")
+    cam = Cam.from_design(design)
+    calls = []
+
+    def refuse(pieces, delta):
+        calls.append(delta)
+
+    monkeypatch.setattr(contour, "offset_pieces", refuse)
+    tp = plan_toolpath(cam, design.gcode, name="x", thickness=design.cam.thickness, bore=design.cam.bore)
+    assert calls, "the offset was not tried"
+    *rough, _ = profile_passes(tp)
+    planar = [m for m in rough[-1] if m.kind.is_arc or m.start[:2] != m.end[:2]][1:-1]
+    path = np.vstack([densify(m) for m in planar])[:, :2]
+    exact = np.asarray(cam.offset(np.linspace(0.0, 2.0 * math.pi, 200_001), tp.rough_offset).point)
+    assert distance_to_polyline(path, exact).max() <= design.gcode.tolerance
+    assert distance_to_polyline(exact[::4], path).max() <= design.gcode.tolerance
 
 
 def test_climb_runs_clockwise_and_conventional_counter_clockwise():

@@ -37,6 +37,8 @@ __all__ = [
     "curve_nodes",
     "distance_to_pieces",
     "measure_deviation",
+    "norm2",
+    "offset_pieces",
     "sample_pieces",
     "take_pieces",
 ]
@@ -105,6 +107,16 @@ def angle_of(v: FloatArray) -> FloatArray:
 def cross(a: FloatArray, b: FloatArray) -> FloatArray:
     """z-component of the cross product of 2-D vectors (..., 2)."""
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def norm2(v: FloatArray) -> FloatArray:
+    """Length of 2-D vectors (..., 2): ``np.linalg.norm(v, axis=-1)`` to the last bit, without its reduction.
+
+    Hand-written because the reduction over an axis of two is several times slower.
+    """
+    x, y = v[..., 0], v[..., 1]
+    out: FloatArray = np.sqrt(x * x + y * y)
+    return out
 
 
 def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -255,7 +267,7 @@ def distance_to_pieces(q: FloatArray, pieces: Pieces) -> FloatArray:
         w = e - s
         ww = np.maximum(_dot(w, w), 1e-300)
         t = np.clip(_dot(q - s, w) / ww, 0.0, 1.0)
-        d_line = np.linalg.norm(q - (s + w * t[..., None]), axis=-1)
+        d_line = norm2(q - (s + w * t[..., None]))
         # arc: radial distance inside the sweep, else the nearer end point
         radius = 0.5 * (pieces.r_start[:, k] + pieces.r_end[:, k])[:, None]
         spiral = 0.5 * np.abs(pieces.r_end[:, k] - pieces.r_start[:, k])[:, None]
@@ -263,38 +275,40 @@ def distance_to_pieces(q: FloatArray, pieces: Pieces) -> FloatArray:
         rel = angle_of(q - c) - angle_of(s - c)
         along = np.where(sweep >= 0.0, np.mod(rel, 2.0 * np.pi), np.mod(-rel, 2.0 * np.pi))
         inside = along <= np.abs(sweep)
-        radial = np.abs(np.linalg.norm(q - c, axis=-1) - radius) + spiral
-        ends = np.minimum(np.linalg.norm(q - s, axis=-1), np.linalg.norm(q - e, axis=-1))
+        radial = np.abs(norm2(q - c) - radius) + spiral
+        ends = np.minimum(norm2(q - s), norm2(q - e))
         d_arc = np.where(inside, radial, ends)
         best = np.minimum(best, np.where(pieces.line[:, k, None], d_line, d_arc))
     return best
 
 
 def _distance_to_curve(
-    curve: CurveFn, p: FloatArray, guess: FloatArray, lo: FloatArray, hi: FloatArray
+    curve: CurveFn,
+    p: FloatArray,
+    guess: FloatArray,
+    low: FloatArray,
+    high: FloatArray,
+    at_guess: tuple[FloatArray, FloatArray, FloatArray],
 ) -> FloatArray:
-    """Upper bound of the distance [mm] from points p (n, m, 2) to the curve.
+    """Upper bound of the distance [mm] from points p (N, 2) to the curve.
 
-    Newton's method on g(φ) = (C(φ) − p)·C′(φ) from ``guess`` (n, m), kept in
-    [lo − h, hi + h] with h the interval length; every iterate is a point of
-    the curve, so the smallest distance seen bounds the true one from above.
+    Newton's method on g(φ) = (C(φ) − p)·C′(φ) from ``guess`` (N,), kept in
+    [low, high]; every iterate is a point of the curve, so the smallest
+    distance seen bounds the true one from above. ``at_guess`` is C, C′, C″
+    at the guesses (already known to the caller).
     """
-    shape = guess.shape
-    span = (hi - lo)[:, None]
-    low, high = (lo[:, None] - span), (hi[:, None] + span)
     phi = guess.copy()
-    flat = p.reshape(-1, 2)
-    best = np.full(shape, np.inf)
+    best = np.full(guess.shape, np.inf)
     for step in range(_NEWTON_STEPS + 1):
-        pt, d1, d2 = curve(phi.ravel())
-        diff = pt - flat
-        best = np.minimum(best, np.linalg.norm(diff, axis=-1).reshape(shape))
+        pt, d1, d2 = at_guess if step == 0 else curve(phi)
+        diff = pt - p
+        best = np.minimum(best, norm2(diff))
         if step == _NEWTON_STEPS:
             break
         g = _dot(diff, d1)
         gp = _dot(d1, d1) + _dot(diff, d2)
         gp = np.where(gp > 0.0, gp, _dot(d1, d1))
-        phi = np.clip(phi - (g / gp).reshape(shape), low, high)
+        phi = np.clip(phi - g / gp, low, high)
     return best
 
 
@@ -342,23 +356,87 @@ def measure_deviation(curve: CurveFn, pieces: Pieces, *, samples: int = _SAMPLES
     n = len(pieces)
     u = (np.arange(samples) + 1.0) / (samples + 1.0)
     phi = pieces.lo[:, None] + (pieces.hi - pieces.lo)[:, None] * u
-    q, _, _ = curve(phi.ravel())
-    q = q.reshape(n, samples, 2)
+    # the curve at the ends and the samples of every interval, in one evaluation
+    cand_phi = np.concatenate((pieces.lo[:, None], phi, pieces.hi[:, None]), axis=1)
+    c_pt, c_d1, c_d2 = (v.reshape(n, samples + 2, 2) for v in curve(cand_phi.ravel()))
+    cand = c_pt
+    q = c_pt[:, 1:-1]
     to_pieces = _peak(distance_to_pieces(q, pieces))
     half = max(samples // 2, 2)
     pts = sample_pieces(pieces, half).reshape(n, 2 * half, 2)
-    ends, _, _ = curve(np.concatenate((pieces.lo, pieces.hi)))
-    cand = np.concatenate((ends[:n, None, :], q, ends[n:, None, :]), axis=1)
-    cand_phi = np.concatenate((pieces.lo[:, None], phi, pieces.hi[:, None]), axis=1)
-    gap = np.linalg.norm(pts[:, :, None, :] - cand[:, None, :, :], axis=-1)
-    guess = np.take_along_axis(cand_phi, gap.argmin(axis=2), axis=1)
-    to_curve = np.maximum(
-        _peak(_distance_to_curve(curve, pts[:, :half], guess[:, :half], pieces.lo, pieces.hi)),
-        _peak(_distance_to_curve(curve, pts[:, half:], guess[:, half:], pieces.lo, pieces.hi)),
-    )
+    # each piece sample is projected onto the curve in [lo − h, hi + h] (h the interval's length),
+    # from the nearest curve sample of its interval; a null second piece (a single arc's) is one
+    # point sampled `half` times: it is projected once
+    null = pieces.line[:, 1] & np.all(pieces.start[:, 1] == pieces.end[:, 1], axis=1)
+    take = np.ones((n, 2 * half), dtype=bool)
+    take[null, half + 1 :] = False
+    rows, cols = np.nonzero(take)
+    near = norm2(pts[rows, cols][:, None, :] - cand[rows]).argmin(axis=1)
+    span = pieces.hi - pieces.lo
+    dist = np.empty((n, 2 * half))
+    dist[rows, cols] = _distance_to_curve(
+        curve, pts[rows, cols], cand_phi[rows, near], (pieces.lo - span)[rows], (pieces.hi + span)[rows],
+        (c_pt[rows, near], c_d1[rows, near], c_d2[rows, near]),
+    )  # fmt: skip
+    dist[null, half + 1 :] = dist[null, half : half + 1]
+    to_curve = np.maximum(_peak(dist[:, :half]), _peak(dist[:, half:]))
     out = np.maximum(to_pieces, to_curve)
     readonly(out)
     return out
+
+
+def offset_pieces(pieces: Pieces, delta: float) -> Pieces | None:
+    """The tangent-continuous chain of pieces offset by ``delta`` [mm] to the left of travel (increasing φ).
+
+    An arc offset is the concentric arc of radius r − δ (counter-clockwise)
+    or r + δ (clockwise) over the same angles, a line moves by δ along its
+    left normal, and a null piece (a single arc's empty second piece) moves
+    with the end of the piece before it. Because the chain is tangent
+    continuous the offset pieces join again: the offset of an arc spline of
+    a curve C is an arc spline of the offset curve C + δ·n with the same
+    number of pieces (a circle's offset is the concentric circle). Its
+    distance from the offset curve is not implied by the original's and
+    must be measured.
+
+    Returns None where an arc would vanish or turn inside out (|δ| ≥ r on
+    its concave side); the caller then fits the offset curve itself.
+    """
+    n = len(pieces)
+    start, end = pieces.start.reshape(-1, 2), pieces.end.reshape(-1, 2)
+    center = pieces.center.reshape(-1, 2)
+    ccw, line = pieces.ccw.reshape(-1), pieces.line.reshape(-1)
+    radius = pieces.r_start.reshape(-1)
+    chord = end - start
+    length = np.linalg.norm(chord, axis=1)
+    null = line & (length <= 0.0)
+    turn = np.where(ccw, 1.0, -1.0)
+    new_r = radius - delta * turn
+    if np.any(~line & (new_r <= 0.0)):
+        return None
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u_s = (start - center) / radius[:, None]
+        u_e = (end - center) / radius[:, None]
+        d = chord / length[:, None]
+    left = np.stack((-d[:, 1], d[:, 0]), axis=1)
+    a_start = center + new_r[:, None] * u_s
+    a_end = center + new_r[:, None] * u_e
+    out_s = np.where(line[:, None], start + delta * left, a_start)
+    out_e = np.where(line[:, None], end + delta * left, a_end)
+    # a null piece sits where the previous real piece ends (the chain is closed)
+    real = np.flatnonzero(~null)
+    if real.size == 0:
+        return None
+    prev = real[np.searchsorted(real, np.arange(null.size), side="right") - 1]
+    at = out_e[prev]
+    out_s = np.where(null[:, None], at, out_s)
+    out_e = np.where(null[:, None], at, out_e)
+    out_c = np.where(null[:, None], at, np.where(line[:, None], 0.5 * (out_s + out_e), center))
+    r_out = np.where(line, 0.0, new_r)
+    return Pieces(
+        lo=pieces.lo, hi=pieces.hi, start=out_s.reshape(n, 2, 2), end=out_e.reshape(n, 2, 2),
+        center=out_c.reshape(n, 2, 2), r_start=r_out.reshape(n, 2), r_end=r_out.reshape(n, 2).copy(),
+        ccw=pieces.ccw, line=pieces.line,
+    )  # fmt: skip
 
 
 def curve_nodes(curve: CurveFn, phi: FloatArray) -> tuple[FloatArray, FloatArray]:
