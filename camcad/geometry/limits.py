@@ -7,7 +7,6 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from camcad._typing import FloatArray, readonly
 from camcad.angles import TWO_PI, flagged_ranges, format_ranges
@@ -136,6 +135,8 @@ def _bad_range(quantity: Quantity, limit: float, worst: Extreme, step: float) ->
     def root(inside: float, outside: float) -> float:
         if g(outside) < 0.0:
             return outside
+        from scipy.optimize import brentq  # here: only a broken limit's range needs it
+
         return float(brentq(g, min(inside, outside), max(inside, outside), xtol=1e-12))
 
     centre = worst.phi
@@ -315,6 +316,7 @@ def analyse_geometry(
             ranges=tuple(ranges), worst=worst.value, worst_angle=worst.phi, worst_side=worst.side
         )
     findings += _velocity_jumps(cam)
+    findings += _reversals(cam)
     s = np.asarray(motion.s)
     readonly(phi)
     analysis = GeometryAnalysis(
@@ -386,6 +388,72 @@ def _velocity_jumps(cam: Cam) -> list[Finding]:
                 value=joint.dv,
                 limit=0.0,
                 unit="mm/rad",
+            )
+        )
+    return out
+
+
+_REVERSAL_RTOL = 1e-9  # of the segment's mean |ds/dφ|: round-off, not a reversal
+
+
+def _reversals(cam: Cam) -> list[Finding]:
+    """A soft finding for every rise that runs backwards somewhere (or return that runs forwards).
+
+    Fixed laws never do; a blend polynomial can, when its lift is too small
+    for the end velocities its neighbours ask for (it must overshoot to meet
+    them), and so can a point table. The worst backward ds/dφ is the true
+    extreme: the densest sample refined by bounded minimisation (Brent) on the
+    exact motion.
+    """
+    from scipy.optimize import minimize_scalar
+
+    out = []
+    program = cam.program
+    for k, (seg, start) in enumerate(zip(program.segments, program.starts, strict=True)):
+        if seg.kind.value not in ("rise", "return") or seg.lift <= 0.0:
+            continue
+        sense = 1.0 if seg.kind.value == "rise" else -1.0
+        x = np.linspace(0.0, 1.0, 2001)
+        back = -sense * cam.motion(start + x * seg.span).v  # > 0 where the follower runs backwards
+        wrong = back > _REVERSAL_RTOL * seg.lift / seg.span
+        # a segment that starts or ends moving the other way (a return out of a constant-velocity
+        # rise) must run that way next to that end: only a backward run inside the segment is a flaw
+        inherited = np.zeros_like(wrong)
+        for edge, step in ((0, 1), (x.size - 1, -1)):
+            i = edge
+            while 0 <= i < x.size and wrong[edge] and wrong[i]:
+                inherited[i] = True
+                i += step
+        back = np.where(wrong & ~inherited, back, 0.0)
+        worst = int(np.argmax(back))
+        if back[worst] <= 0.0:
+            continue
+        lo, hi = x[max(worst - 1, 0)], x[min(worst + 1, x.size - 1)]
+
+        def forward(u: float, start: float = start, span: float = seg.span, sense: float = sense) -> float:
+            return sense * float(cam.motion(np.array([start + u * span])).v[0])
+
+        res = minimize_scalar(forward, bounds=(lo, hi), method="bounded", options={"xatol": 1e-12})
+        phi = start + float(res.x) * seg.span
+        value = max(-sense * float(res.fun), float(back[worst]))
+        span = np.degrees(start + x[back > 0.0] * seg.span)
+        unit = cam.follower.kind.lift_unit
+        out.append(
+            Finding(
+                kind="motion reversal",
+                severity=Severity.SOFT,
+                field=f"motion[{k}].lift",
+                message=(
+                    f"motion[{k}].lift: the {seg.kind.value} runs backwards between {span.min():.1f}° and "
+                    f"{span.max():.1f}° (ds/dφ = {-sense * value:+.4g} {unit}/rad at "
+                    f"{math.degrees(phi):.1f}°): "
+                    "its law must overshoot to meet the velocities of its neighbours; give it more lift or a "
+                    "longer angle"
+                ),
+                angle=phi % TWO_PI,
+                value=-sense * value,
+                limit=0.0,
+                unit=f"{unit}/rad",
             )
         )
     return out

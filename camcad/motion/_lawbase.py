@@ -75,6 +75,15 @@ class Law(ABC):
         """Interior x where the law switches formula and y″ or y‴ may jump."""
         return ()
 
+    @property
+    def knots(self) -> tuple[float, ...]:
+        """Interior x where the law switches formula but stays smooth through y‴ (a spline's knots).
+
+        Not joints: nothing jumps there. ``MotionProgram.smooth_knots`` lists
+        them in φ, for quadratures that converge fastest split there.
+        """
+        return ()
+
     @abstractmethod
     def describe(self) -> str:
         """Return a short human description such as ``"VAP b=0.1"``."""

@@ -24,6 +24,7 @@ from typing import ClassVar
 
 from camcad._typing import ArrayLike
 from camcad.errors import DesignError
+from camcad.motion._blendlaws import MAX_POLYNOMIAL_DEGREE, InclinedSine, Polynomial
 from camcad.motion._lawbase import (
     _PI,
     DUDLEY_MAX_DEGREE,
@@ -37,6 +38,7 @@ from camcad.motion._lawbase import (
     _sinpi,
     _unknown,
 )
+from camcad.motion._mscv import ModifiedSineCV
 from camcad.motion._polynomial import Dudley, Poly345, Poly4567, dudley_coefficients, dudley_matrix
 from camcad.motion._scca import ModifiedSine, ModifiedTrapezoid
 from camcad.motion._vap import Vap
@@ -49,13 +51,16 @@ __all__ = [
     "Derivatives",
     "Dudley",
     "Harmonic",
+    "InclinedSine",
     "Law",
     "LawInfo",
     "LawParameter",
     "ModifiedSine",
+    "ModifiedSineCV",
     "ModifiedTrapezoid",
     "Poly345",
     "Poly4567",
+    "Polynomial",
     "Vap",
     "dudley_coefficients",
     "dudley_matrix",
@@ -169,6 +174,14 @@ _DEGREE = LawParameter(
     name="degree", kind=int, default=None, allowed=f"odd integer 3 ≤ degree ≤ {DUDLEY_MAX_DEGREE}"
 )
 
+_CV = LawParameter(name="cv", kind=float, default=None, allowed="0 ≤ cv < 1")
+_POLY_DEGREE = LawParameter(
+    name="degree",
+    kind=int,
+    default=0,
+    allowed=f"5 ≤ degree ≤ {MAX_POLYNOMIAL_DEGREE}; omitted: the lowest degree (5, or 6-7 with a given jerk)",
+)
+
 _ENTRIES: tuple[tuple[type[Law], str, tuple[LawParameter, ...]], ...] = (
     (ConstantVelocity, "y = x; velocity jumps at the ends", ()),
     (Harmonic, "simple harmonic; acceleration jumps at the ends, peak y' = pi/2", ()),
@@ -178,7 +191,18 @@ _ENTRIES: tuple[tuple[type[Law], str, tuple[LawParameter, ...]], ...] = (
     (Dudley, "Dudley odd-degree polynomial; derivatives 1..(n-1)/2 zero at the ends", (_DEGREE,)),
     (ModifiedTrapezoid, "modified trapezoid (SCCA); peak y' = 2, low peak acceleration", ()),
     (ModifiedSine, "modified sine (SCCA); peak y' = 1.76", ()),
+    (
+        ModifiedSineCV,
+        "modified sine with a share cv of the span at constant velocity (VDI 2143); cv = 0: modified sine",
+        (_CV,),
+    ),
     (Vap, "VAP function; near-constant velocity, acceleration jumps at the ends", (_B,)),
+    (
+        Polynomial,
+        "blend polynomial meeting the neighbours' (or the given) s, v, a; least jerk norm when degree > 5",
+        (_POLY_DEGREE,),
+    ),
+    (InclinedSine, "inclined sine (Bestehorn, VDI 2143); takes its end velocities from the neighbours", ()),
 )
 
 _CLASSES: dict[str, type[Law]] = {cls.name: cls for cls, _, _ in _ENTRIES}

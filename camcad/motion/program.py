@@ -9,13 +9,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
 from camcad.extremes import Side
+from camcad.motion._blendlaws import InclinedSine, Polynomial
+from camcad.motion.blend import resolve_blends
 from camcad.motion.segments import SegmentKind, SegmentSpec
 
 __all__ = [
@@ -130,10 +132,19 @@ class MotionProgram:
     segments: tuple[SegmentSpec, ...]
     starts: tuple[float, ...]  # rad, start angle of each segment
     base_s: tuple[float, ...]  # mm, displacement at each segment's start
+    _memo: dict[str, tuple[Joint, ...]] = field(  # the joints, found once (see joints)
+        default_factory=dict, init=False, compare=False, hash=False, repr=False
+    )
 
     @classmethod
     def from_segments(cls, segments: Sequence[SegmentSpec]) -> MotionProgram:
-        """Lay the segments end to end from φ = 0."""
+        """Lay the segments end to end from φ = 0, solving the blend points first.
+
+        Segments whose law adapts to its neighbours (``polynomial``,
+        ``inclined-sine``) are resolved by :func:`~camcad.motion.blend.resolve_blends`;
+        ``segments`` of the result holds the resolved laws.
+        """
+        segments = resolve_blends(segments)
         starts, base_s = [], []
         phi = s = 0.0
         for seg in segments:
@@ -149,9 +160,13 @@ class MotionProgram:
     @property
     def lift(self) -> float:
         """Largest displacement of the program [mm]."""
-        pairs = zip(self.base_s, self.segments, strict=True)
-        ends = [b + (g.lift if g.kind is SegmentKind.RISE else 0.0) for b, g in pairs]
-        return max([*self.base_s, *ends])
+        peaks = []
+        for base, seg in zip(self.base_s, self.segments, strict=True):
+            if seg.kind is SegmentKind.RISE:
+                peaks.append(base + seg.lift)
+            elif seg.kind is SegmentKind.TABLE and seg.law is not None:
+                peaks.append(float(getattr(seg.law, "peak", 0.0)))
+        return max([*self.base_s, *peaks])
 
     @property
     def segment_bounds(self) -> tuple[float, ...]:
@@ -181,7 +196,7 @@ class MotionProgram:
             for xb in seg.law.breakpoints:
                 x = np.where(np.abs(x - xb) <= _SNAP, np.nextafter(xb, toward), x)
         y, y1, y2, y3 = seg.law.evaluate(x)
-        h = seg.lift if seg.kind is SegmentKind.RISE else -seg.lift
+        h = seg.signed_lift  # a table's law gives s itself [mm]: h = 1
         beta = seg.span
         # chain rule: x = (φ − φ0)/β, so d^k/dφ^k = β^-k d^k/dx^k
         return base + h * y, h * y1 / beta, h * y2 / beta**2, h * y3 / beta**3
@@ -230,7 +245,13 @@ class MotionProgram:
         Points inside a segment where its law switches formula (the SCCA laws'
         phase changes, the middle of a VAP rise, where y″ jumps) are reported
         too, with ``internal=True``, since the fit needs knots there as well.
+        Computed once per program (every true-extremes search asks for them).
         """
+        if "joints" not in self._memo:
+            self._memo["joints"] = self._find_joints()
+        return self._memo["joints"]
+
+    def _find_joints(self) -> tuple[Joint, ...]:
         n = len(self.segments)
         places: list[tuple[float, int, int, float, float, bool]] = []
         for k, seg in enumerate(self.segments):
@@ -268,6 +289,44 @@ class MotionProgram:
     def breakpoints(self) -> tuple[Breakpoint, ...]:
         """Every segment joint with its continuity order (the fit puts knots here)."""
         return tuple(Breakpoint(phi=jt.phi, continuity=jt.continuity) for jt in self.joints())
+
+    @property
+    def blend_points(self) -> tuple[Breakpoint, ...]:
+        """The joints next to a segment whose law took its boundary values from its neighbours.
+
+        (``polynomial``, ``inclined-sine``), with their continuity: what a
+        plot marks as blend points.
+        """
+        n = len(self.segments)
+        adaptive = [isinstance(g.law, (Polynomial, InclinedSine)) for g in self.segments]
+        return tuple(
+            Breakpoint(phi=jt.phi, continuity=jt.continuity)
+            for jt in self.joints()
+            if not jt.internal and (adaptive[jt.index] or adaptive[(jt.index - 1) % n])
+        )
+
+    @property
+    def smooth_knots(self) -> tuple[float, ...]:
+        """Angles [rad] where a law switches formula but s, v, a, j stay continuous (``Law.knots``).
+
+        A point table's spline knots. Not joints (nothing jumps there), but a
+        quadrature over the turn converges fastest split there as well.
+        """
+        out = {
+            start + x * seg.span
+            for start, seg in zip(self.starts, self.segments, strict=True)
+            for x in (seg.law.knots if seg.law is not None else ())
+        }
+        return tuple(sorted(out))
+
+    @property
+    def pieces(self) -> tuple[float, ...]:
+        """Every angle [rad] where the formula of s(φ) changes: breakpoints and smooth knots, sorted.
+
+        A quadrature or flattening of anything built on the motion converges
+        fastest split there (Gauss-Legendre is exponential only on smooth pieces).
+        """
+        return tuple(sorted({bp.phi for bp in self.breakpoints} | set(self.smooth_knots)))
 
     def sample_phi(self, step: float) -> FloatArray:
         """Cam angles in [0, 2π): a uniform grid of ``step`` [rad] plus every breakpoint."""

@@ -40,6 +40,7 @@ CASES: list[tuple[str, dict[str, object]]] = [
     *[("dudley", {"degree": n}) for n in (3, 5, 7, 9, 11)],
     ("modified-trapezoid", {}),
     ("modified-sine", {}),
+    *[("modified-sine-cv", {"cv": c}) for c in (0.2, 0.5)],
     *[("vap", {"b": b}) for b in (0.1, 0.5, 0.9)],
 ]
 LAWS_UNDER_TEST = [make_law(name, **params) for name, params in CASES]
@@ -310,7 +311,10 @@ def test_registry_names_and_order() -> None:
         "dudley",
         "modified-trapezoid",
         "modified-sine",
+        "modified-sine-cv",
         "vap",
+        "polynomial",
+        "inclined-sine",
     ]
     for name, info in LAWS.items():
         assert isinstance(info, LawInfo)
@@ -387,3 +391,46 @@ def test_direct_construction_is_validated() -> None:
     with pytest.raises(DesignError) as info:
         dudley_matrix(9, 0.0)
     assert info.value.path == "phi2"
+
+
+# ------------------------------------------------- modified sine with constant velocity
+
+
+def _rothbart_ms(x: np.ndarray) -> np.ndarray:
+    """The modified sine in Rothbart's three-piece closed form (Cam Design Handbook, ch. 2)."""
+    k = 1.0 / (4.0 + math.pi)
+    return np.where(
+        x < 1 / 8,
+        k * (math.pi * x - 0.25 * np.sin(4 * math.pi * x)),
+        np.where(
+            x < 7 / 8,
+            k * (2 + math.pi * x - 2.25 * np.sin(4 * math.pi * x / 3 + math.pi / 3)),
+            k * (4 + math.pi * x - 0.25 * np.sin(4 * math.pi * x)),
+        ),
+    )
+
+
+@pytest.mark.parametrize("cv", [0.0, 0.25, 0.6])
+def test_modified_sine_cv_against_rothbart_and_a_straight_middle(cv: float) -> None:
+    """Accelerating part: Rothbart's MS over w = 1 − cv, scaled by A; then a line of the peak slope."""
+    law = make_law("modified-sine-cv", cv=cv)
+    w = 1.0 - cv
+    peak = 4 * math.pi / (4 + math.pi)  # Rothbart's MS: y'(1/2) = π(1 + 3)/(4 + π)
+    amp = 1.0 / (1.0 + cv * peak / w)
+    x = np.linspace(0.0, 0.5 * w, 200)
+    assert_allclose(law.evaluate(x)[0], amp * _rothbart_ms(x / w), atol=1e-14)
+    mid = np.linspace(0.5 * w, 1 - 0.5 * w, 50)
+    y, y1, y2, _ = law.evaluate(mid)
+    assert_allclose(y1, amp * peak / w, rtol=1e-12)
+    assert_allclose(y2, 0.0, atol=1e-12)
+    if cv > 0.0:
+        assert_allclose(np.diff(y) / np.diff(mid), amp * peak / w, rtol=1e-9)
+    if cv == 0.0:
+        assert_allclose(law.evaluate(GRID)[0], make_law("modified-sine").evaluate(GRID)[0], atol=1e-15)
+
+
+def test_modified_sine_cv_rejects_a_share_outside_zero_to_one() -> None:
+    for bad in (-0.1, 1.0, "half", True):
+        with pytest.raises(DesignError) as err:
+            make_law("modified-sine-cv", cv=bad)
+        assert err.value.path == "cv"

@@ -1,0 +1,376 @@
+"""Point tables: a lift measured or given point by point, smoothed into an exact motion law.
+
+``law = "table"`` reads angle [°] → lift [mm, or ° of swing on an arm]
+(optionally a velocity column ds/dφ [mm/rad]) over the whole turn. The motion
+is the periodic quintic smoothing spline through the points (FITPACK's
+``percur`` via :func:`scipy.interpolate.make_splrep`), so s, v, a and the
+jerk j are continuous everywhere and known exactly at any angle. The
+smoothing is set by the stated measurement noise σ: weights 1/σ and the
+smoothing factor S = m (Dierckx 1993, §5.2.1: with w = 1/σ the residual sum
+Σ (r/σ)² should be about m, the number of points).
+
+The fit reports its residuals and flags the points where the *table's own*
+acceleration or jerk (its second and third divided differences) departs from
+the smooth law's by more than the stated noise can explain (4 standard
+deviations of that difference under noise σ): spikes from a bad point, or a
+noise stated too small.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol
+
+import numpy as np
+
+from camcad._typing import ArrayLike, FloatArray, readonly
+from camcad.angles import TWO_PI
+from camcad.errors import DesignError
+from camcad.motion._lawbase import Derivatives, Law, _as_x, _finish
+
+__all__ = [
+    "MAX_TABLE_POINTS",
+    "TableFit",
+    "TableFlag",
+    "TableLaw",
+    "parse_table_text",
+    "smooth_table",
+    "table_summary",
+]
+
+MAX_TABLE_POINTS = 36_000
+"""Most rows a point table may have (one every 0.01°)."""
+MIN_TABLE_POINTS = 12
+"""Fewest rows: a periodic quintic needs a dozen points to be determined at all."""
+FLAG_SIGMAS = 4.0
+"""A difference beyond this many standard deviations of what the noise explains is flagged."""
+
+
+class SegmentLike(Protocol):
+    """Anything with a ``law`` (a :class:`~camcad.motion.segments.SegmentSpec`)."""
+
+    @property
+    def law(self) -> Law | None:
+        """The segment's law."""
+        ...
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TableFlag:
+    """One implausible place in a point table.
+
+    Attributes
+    ----------
+    angle
+        Cam angle of the table row [rad].
+    quantity
+        ``"lift"`` (residual), ``"acceleration"`` or ``"jerk"``.
+    value
+        The table's own value there, minus the smooth law's: residual [mm],
+        second divided difference [mm/rad²] or third [mm/rad³].
+    limit
+        What the stated noise explains (``FLAG_SIGMAS`` standard deviations), same unit.
+    """
+
+    angle: float
+    quantity: str
+    value: float
+    limit: float
+
+    def describe(self, unit: str = "mm") -> str:
+        """One line, e.g. ``'41.0°: acceleration off by +3.1 mm/rad² (noise explains 0.8)'``."""
+        power = {"lift": "", "acceleration": "/rad²", "jerk": "/rad³"}[self.quantity]
+        what = "lift" if self.quantity == "lift" else f"table {self.quantity}"
+        return (
+            f"{math.degrees(self.angle):.3f}°: {what} off the smooth law by {self.value:+.4g} {unit}{power} "
+            f"(the stated noise explains {self.limit:.3g})"
+        )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TableFit:
+    """What the smoothing did: residuals per point, their size, and the flagged places.
+
+    Attributes
+    ----------
+    angle
+        (m,) table angles [rad].
+    residual
+        (m,) table lift minus smooth law [mm].
+    noise
+        The stated noise σ [mm].
+    flags
+        Implausible places, in angle order.
+    velocity_residual
+        (m,) table velocity minus the law's [mm/rad], when the table has a velocity column.
+    """
+
+    angle: FloatArray
+    residual: FloatArray
+    noise: float
+    flags: tuple[TableFlag, ...]
+    velocity_residual: FloatArray | None = None
+
+    @property
+    def rms(self) -> float:
+        """Root mean square of the residuals [mm]."""
+        return float(np.sqrt(np.mean(self.residual**2)))
+
+    @property
+    def worst(self) -> tuple[float, float]:
+        """(largest |residual| [mm], its angle [rad])."""
+        i = int(np.argmax(np.abs(self.residual)))
+        return float(abs(self.residual[i])), float(self.angle[i])
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TableLaw(Law):
+    """The smoothing spline of a point table, as a law over the whole turn.
+
+    Unlike the normalised laws, ``evaluate`` returns the displacement itself
+    [mm] at x = φ/2π and its x-derivatives (the program scales them by
+    β = 2π and h = 1).
+
+    Attributes
+    ----------
+    knot_vector, coefficients
+        The periodic quintic B-spline s(φ), φ in rad.
+    source
+        The table's name for messages and the report (the file name).
+    fit
+        Residuals and flags (not part of equality).
+    """
+
+    name: ClassVar[str] = "table"
+    knot_vector: tuple[float, ...]
+    coefficients: tuple[float, ...]
+    source: str = ""
+    fit: TableFit | None = field(default=None, compare=False, hash=False, repr=False)
+
+    def _spline(self) -> Any:
+        """The law as SciPy's periodic quintic BSpline (imported here: only tables need SciPy's splines)."""
+        from scipy.interpolate import BSpline
+
+        return BSpline(np.asarray(self.knot_vector), np.asarray(self.coefficients), 5, extrapolate="periodic")
+
+    def evaluate(self, x: ArrayLike) -> Derivatives:
+        """Evaluate s [mm] and its x-derivatives at x = φ/2π (see the class notes)."""
+        xa = _as_x(x)
+        spline = self._spline()
+        phi = TWO_PI * xa
+        out = [spline(phi, nu=m) * TWO_PI**m for m in range(4)]  # d/dx = 2π d/dφ
+        return _finish(xa.shape, *out)
+
+    @property
+    def peak(self) -> float:
+        """Largest displacement of the smooth law [mm]: the spline at the roots of its velocity."""
+        spline = self._spline()
+        from scipy.interpolate import PPoly
+
+        roots = PPoly.from_spline(spline.derivative()).roots(extrapolate=False)  # where v = 0
+        knots = np.asarray(self.knot_vector)
+        return float(np.max(spline(np.concatenate([roots[np.isfinite(roots)], knots]))))
+
+    @property
+    def knots(self) -> tuple[float, ...]:
+        """The spline's distinct interior knots as x = φ/2π in (0, 1) (C4 there: s, v, a, j continuous)."""
+        t = np.unique(np.mod(np.asarray(self.knots_phi), TWO_PI)) / TWO_PI
+        return tuple(float(x) for x in t if 0.0 < x < 1.0)
+
+    @property
+    def knots_phi(self) -> tuple[float, ...]:
+        """The spline's knot vector over one period [rad]."""
+        k = 5
+        return self.knot_vector[k:-k]
+
+    @property
+    def zero_at_start(self) -> tuple[int, ...]:
+        """Nothing is forced to 0 at φ = 0; the law is periodic and smooth there."""
+        return ()
+
+    def describe(self) -> str:
+        """Return e.g. ``"point table lift.csv (360 points, σ = 0.005)"``."""
+        if self.fit is None:
+            return f"point table {self.source}".strip()
+        return f"point table {self.source} ({self.fit.angle.size} points, σ = {self.fit.noise:g})".strip()
+
+
+def parse_table_text(text: str, *, where: str = "file") -> tuple[FloatArray, FloatArray, FloatArray | None]:
+    """Read the rows of a point table: angle [°], lift, optional velocity; further columns ignored.
+
+    Parameters
+    ----------
+    text
+        CSV text (commas, semicolons, tabs or spaces); an optional header line
+        (any first line that is not numbers); ``#`` starts a comment.
+    where
+        Field path for errors (``motion[0].file``).
+
+    Returns
+    -------
+    tuple
+        (angle [rad], lift, velocity or None), each (m,) read-only.
+    """
+    rows: list[list[float]] = []
+    widths: set[int] = set()
+    first_data = True
+    for number, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        cells = [c for c in line.replace(";", ",").replace("\t", ",").replace(" ", ",").split(",") if c]
+        try:
+            values = [float(c) for c in cells]
+        except ValueError:
+            if first_data and not rows:
+                first_data = False
+                continue  # the header
+            raise DesignError(where, f"line {number}: {line[:60]!r} is not numbers") from None
+        first_data = False
+        if len(values) < 2:
+            raise DesignError(where, f"line {number}: needs angle and lift, got {len(values)} value")
+        if not all(math.isfinite(v) for v in values):
+            raise DesignError(where, f"line {number}: {line[:60]!r} holds a value that is not finite")
+        widths.add(min(len(values), 3))
+        rows.append(values[:3])
+        if len(rows) > MAX_TABLE_POINTS:
+            raise DesignError(where, f"more than {MAX_TABLE_POINTS} rows; allowed: at most one per 0.01°")
+    if len(widths) > 1:
+        raise DesignError(where, "rows have different numbers of columns (angle, lift[, velocity])")
+    if len(rows) < MIN_TABLE_POINTS:
+        raise DesignError(where, f"{len(rows)} rows; allowed: at least {MIN_TABLE_POINTS} over the turn")
+    data = np.asarray(rows, dtype=float)
+    angle_deg = data[:, 0]
+    if angle_deg[0] < 0.0 or angle_deg[-1] > 360.0:
+        raise DesignError(where, "angles must lie in 0° to 360°")
+    if np.any(np.diff(angle_deg) <= 0.0):
+        bad = int(np.argmax(np.diff(angle_deg) <= 0.0)) + 1
+        raise DesignError(where, f"angles must increase; row {bad + 1} ({angle_deg[bad]:g}°) does not")
+    lift, velocity = data[:, 1], data[:, 2] if data.shape[1] > 2 else None
+    if angle_deg[-1] == 360.0:  # the closing row repeats the first: it must agree, then it is dropped
+        if angle_deg[0] != 0.0 or abs(lift[-1] - lift[0]) > 1e-9 * max(1.0, abs(lift[0])):
+            raise DesignError(where, "a row at 360° must repeat the row at 0° (the table is periodic)")
+        angle_deg, lift = angle_deg[:-1], lift[:-1]
+        velocity = velocity[:-1] if velocity is not None else None
+    angle = np.radians(angle_deg)
+    out = (np.array(angle), np.array(lift), None if velocity is None else np.array(velocity))
+    readonly(*(a for a in out if a is not None))
+    return out
+
+
+def _divided(phi: FloatArray, y: FloatArray, order: int) -> tuple[FloatArray, FloatArray]:
+    """Periodic divided differences of ``order`` (2 or 3) and their weights on y, as (value·k!, weights)."""
+    m = phi.size
+    span = order + 1
+    offsets = np.arange(span) - order // 2  # centred stencil
+    idx = (np.arange(m)[:, None] + offsets[None, :]) % m
+    wraps = np.floor_divide(np.arange(m)[:, None] + offsets[None, :], m)
+    x = phi[idx] + TWO_PI * wraps  # unwrap the angles of the stencil
+    weights = np.ones((m, span))
+    for i in range(span):
+        for k in range(span):
+            if k != i:
+                weights[:, i] /= x[:, i] - x[:, k]
+    weights *= math.factorial(order)  # f[x0..xn]·n! → the order-th derivative
+    return np.sum(weights * y[idx], axis=1), weights
+
+
+def smooth_table(
+    angle: FloatArray, lift: FloatArray, *, noise: float, velocity: FloatArray | None = None, source: str = ""
+) -> TableLaw:
+    """The periodic quintic smoothing spline of a point table, with residuals and flags.
+
+    Parameters
+    ----------
+    angle
+        (m,) strictly increasing cam angles in [0, 2π) [rad].
+    lift
+        (m,) displacement [mm] (or degrees of swing).
+    noise
+        Measurement noise σ [mm], > 0: the spline passes within about σ of
+        the points (Σ (r/σ)² ≈ m).
+    velocity
+        Optional (m,) measured ds/dφ [mm/rad], compared with the law's.
+    source
+        A name for messages.
+
+    Returns
+    -------
+    TableLaw
+        The law; ``law.fit`` has the residuals and flags.
+    """
+    phi = np.asarray(angle, dtype=float)
+    y = np.asarray(lift, dtype=float)
+    m = phi.size
+    x = np.append(phi, phi[0] + TWO_PI)
+    yy = np.append(y, y[0])
+    weights = np.full(x.size, 1.0 / noise)
+    from scipy.interpolate import BSpline, make_splrep
+
+    spline = make_splrep(x, yy, w=weights, k=5, s=float(m), bc_type="periodic")  # Dierckx: S = m for w = 1/σ
+    knots, coefficients = spline.t, spline.c
+    law_spline = BSpline(knots, coefficients, 5, extrapolate="periodic")
+    smooth = law_spline(phi)
+    residual = y - smooth
+    flags: list[TableFlag] = []
+    limit = FLAG_SIGMAS * noise
+    for i in np.flatnonzero(np.abs(residual) > limit):
+        flags.append(TableFlag(angle=float(phi[i]), quantity="lift", value=float(residual[i]), limit=limit))
+    for order, quantity in ((2, "acceleration"), (3, "jerk")):
+        diff, w = _divided(phi, residual, order)  # table's difference minus the law's = difference of r
+        spread = FLAG_SIGMAS * noise * np.sqrt(np.sum(w**2, axis=1))  # its std under noise σ alone
+        centre = (np.arange(m) + 0) % m
+        for i in np.flatnonzero(np.abs(diff) > spread):
+            flags.append(
+                TableFlag(
+                    angle=float(phi[centre[i]]),
+                    quantity=quantity,
+                    value=float(diff[i]),
+                    limit=float(spread[i]),
+                )
+            )
+    flags.sort(key=lambda f: (f.angle, f.quantity))
+    vres = None
+    if velocity is not None:
+        vres = np.asarray(velocity, dtype=float) - law_spline(phi, nu=1)
+        readonly(vres)
+    phi_ro, res_ro = np.array(phi), np.array(residual)
+    readonly(phi_ro, res_ro)
+    fit = TableFit(
+        angle=phi_ro, residual=res_ro, noise=float(noise), flags=tuple(flags), velocity_residual=vres
+    )
+    return TableLaw(
+        knot_vector=tuple(float(t) for t in knots),
+        coefficients=tuple(float(c) for c in coefficients),
+        source=source,
+        fit=fit,
+    )
+
+
+def table_summary(segments: Sequence[SegmentLike], unit: str = "mm") -> dict[str, Any]:
+    """What ``summary.json`` (and the report) say about a point table: residuals and flags.
+
+    Empty when no segment is a point table. ``unit`` is the lift's (``mm`` or ``deg``).
+    """
+    for seg in segments:
+        law = seg.law
+        if isinstance(law, TableLaw) and law.fit is not None:
+            fit = law.fit
+            worst, where = fit.worst
+            out: dict[str, Any] = {
+                "table_file": law.source,
+                "table_points": int(fit.angle.size),
+                f"table_noise_{unit}": fit.noise,
+                f"table_residual_rms_{unit}": fit.rms,
+                f"table_residual_max_{unit}": worst,
+                "table_residual_max_angle_deg": math.degrees(where),
+                "table_flags": [f.describe(unit) for f in fit.flags],
+            }
+            if fit.velocity_residual is not None:
+                out[f"table_velocity_residual_max_{unit}_per_rad"] = float(
+                    np.max(np.abs(fit.velocity_residual))
+                )
+            return out
+    return {}
