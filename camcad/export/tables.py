@@ -24,6 +24,21 @@ straight).
     when the table has turned by θ. It is not the radius of the contact
     point at cam angle φ = θ, which lies off the ray for a roller or offset
     follower; the crossing is solved exactly on the analytic profile.
+
+``polar.txt`` (only with ``[tables] wheel_radius = R``), for cam grinders and
+CMM software: the centre of a wheel (or probe ball, or tool) of radius R
+rolling on the profile, as the distance from the cam axis along the same
+rays θ as ``polar_radius_mm``, at ``polar_step_deg`` with ``polar_decimals``
+decimals (R = 0 gives the profile itself). Plain text, ASCII, LF line ends:
+header lines start with ``#``; then one row per angle, ``angle_deg`` and
+``radius_mm`` separated by one space, angles from 0 up to 360° − step::
+
+    # camcad polar table: my cam
+    # wheel radius 12.5000 mm: distance of the wheel centre from the cam axis
+    # angle a: degrees the cam has turned in its running direction ...
+    # columns: angle_deg radius_mm; 360 rows, step 1 deg, radius 4 decimals
+    0 52.5000
+    1 52.5012
 """
 
 from __future__ import annotations
@@ -36,10 +51,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from camcad._typing import FloatArray, readonly
-from camcad.errors import NotStarShapedError
-from camcad.export.records import write_csv
+from camcad.errors import GougeError, NotStarShapedError
+from camcad.export.records import write_csv, write_text
 from camcad.export.spec import TablesSpec
 from camcad.geometry.spec import Rotation
+from camcad.geometry.tool import check_tool
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -48,9 +64,11 @@ __all__ = [
     "LIFT_HEADER",
     "POINTS_HEADER",
     "polar_radius",
+    "polar_table_text",
     "table_angles",
     "write_lift_csv",
     "write_points_csv",
+    "write_polar_table",
 ]
 
 POINTS_HEADER = "cam_angle_deg,x_mm,y_mm,normal_x,normal_y,radius_of_curvature_mm"
@@ -73,18 +91,27 @@ def _ray_angle(points: FloatArray, sign: float) -> FloatArray:
     return np.arctan2(sign * points[:, 0], points[:, 1])
 
 
-def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation) -> FloatArray:
-    """Radius of the profile along the rays at polar angles θ [mm].
+def _curve(cam: Cam, phi: FloatArray, distance: float) -> FloatArray:
+    """(n, 2) points of the profile (distance 0) or of its offset by ``distance`` [mm]."""
+    out: FloatArray = (cam.profile(phi) if distance == 0.0 else cam.offset(phi, distance)).point
+    return out
+
+
+def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation, distance: float = 0.0) -> FloatArray:
+    """Radius of the profile (or of its offset by ``distance``) along the rays at polar angles θ [mm].
 
     Parameters
     ----------
     cam
-        The exact cam; ``cam.profile(phi)`` gives the contact point at cam
-        angle φ.
+        The exact cam; ``cam.offset(phi, distance)`` gives the point at cam
+        angle φ (the contact point for ``distance = 0``, the centre of a
+        wheel of radius ``distance`` rolling on the profile otherwise).
     theta
         (n,) ray angles [rad], measured like the cam angle (module docstring).
     rotation
         The cam's rotation; fixes which way θ turns.
+    distance
+        Offset of the curve from the profile [mm], 0 for the profile.
 
     Returns
     -------
@@ -108,12 +135,13 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation) -> FloatArr
     sign = 1.0 if rotation is Rotation.CCW else -1.0
     theta = np.asarray(theta, dtype=float)
     grid = np.append(cam.sample_phi(), 2.0 * math.pi)
-    angle = np.unwrap(_ray_angle(cam.profile(grid).point, sign))
+    angle = np.unwrap(_ray_angle(_curve(cam, grid, distance), sign))
     if np.any(np.diff(angle) <= 0.0):
         bad = float(grid[int(np.argmax(np.diff(angle) <= 0.0))])
+        curve, table = ("profile", "lift.csv") if distance == 0.0 else ("wheel-centre path", "polar.txt")
         raise NotStarShapedError(
-            f"cam.base_radius: the profile is not star-shaped about the cam axis near cam angle "
-            f"{math.degrees(bad):.2f}°: a ray meets it twice, so lift.csv has no polar radius; "
+            f"cam.base_radius: the {curve} is not star-shaped about the cam axis near cam angle "
+            f"{math.degrees(bad):.2f}°: a ray meets it twice, so {table} has no polar radius; "
             "use a larger cam.base_radius or a smaller follower.offset"
         )
     start = angle[0]
@@ -123,12 +151,12 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation) -> FloatArr
     base = angle[idx]  # unwrapped angle at lo; the bracket spans < π, so wrap relative to it
     for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
-        value = _ray_angle(cam.profile(mid).point, sign)
+        value = _ray_angle(_curve(cam, mid, distance), sign)
         value = base + np.mod(value - base + math.pi, 2.0 * math.pi) - math.pi
         below = value < target
         lo = np.where(below, mid, lo)
         hi = np.where(below, hi, mid)
-    point = cam.profile(0.5 * (lo + hi)).point
+    point = _curve(cam, 0.5 * (lo + hi), distance)
     out = np.hypot(point[:, 0], point[:, 1])
     readonly(out)
     return out
@@ -192,3 +220,71 @@ def write_lift_csv(path: str | os.PathLike[str], cam: Cam, options: TablesSpec) 
     radius = polar_radius(cam, angle, rotation=cam.rotation)
     columns = dict(zip(LIFT_HEADER.split(","), [np.degrees(angle), lift, radius], strict=True))
     return write_csv(path, columns, formats=["{:.6f}"] * 3)
+
+
+def _angle_decimals(angle_deg: FloatArray) -> int:
+    """Fewest decimals (0–6) that write every angle of the grid exactly (to 1e-9°)."""
+    for d in range(7):
+        if np.all(np.abs(np.round(angle_deg, d) - angle_deg) < 1e-9):
+            return d
+    return 6
+
+
+def polar_table_text(cam: Cam, options: TablesSpec, *, name: str = "") -> str:
+    """The text of ``polar.txt``: wheel-centre radius per ray angle (module docstring).
+
+    Parameters
+    ----------
+    cam
+        The exact cam.
+    options
+        ``[tables]``: ``wheel_radius`` [mm] (required here), ``polar_step``
+        (or ``step``) [rad], ``polar_decimals``.
+    name
+        The design's name for the first line (cleaned to printable ASCII).
+
+    Raises
+    ------
+    GougeError
+        When the wheel is larger than the smallest concave radius of the
+        profile (it cannot reach the concave stretch), naming
+        ``tables.wheel_radius`` and the largest wheel that fits.
+    NotStarShapedError
+        When a ray from the cam axis meets the wheel-centre path twice.
+    """
+    radius = options.wheel_radius
+    if radius is None:
+        raise ValueError("polar.txt needs [tables] wheel_radius")
+    try:
+        check_tool(cam, radius)
+    except GougeError as err:
+        raise GougeError(
+            f"tables.wheel_radius: a wheel of radius {radius:g} mm cannot follow the profile: its "
+            f"smallest concave radius is {err.max_tool_radius:.4f} mm (near φ = "
+            f"{math.degrees(err.phi_range[0]):.1f}°); allowed: wheel_radius ≤ {err.max_tool_radius:.4f} mm",
+            phi_range=err.phi_range,
+            max_tool_radius=err.max_tool_radius,
+        ) from None
+    step = options.step if options.polar_step is None else options.polar_step
+    angle = table_angles(step)
+    rows = polar_radius(cam, angle, rotation=cam.rotation, distance=radius)
+    degrees = np.degrees(angle)
+    a_dec, r_dec = _angle_decimals(degrees), options.polar_decimals
+    sense = "counter-clockwise" if cam.rotation is Rotation.CCW else "clockwise"
+    ray = "(sin a, cos a)" if cam.rotation is Rotation.CCW else "(-sin a, cos a)"
+    title = " ".join("".join(c if 32 <= ord(c) < 127 else " " if ord(c) < 32 else "?" for c in name).split())
+    lines = [
+        f"# camcad polar table: {title}",
+        f"# wheel radius {radius:.4f} mm: distance of the wheel centre from the cam axis",
+        f"# angle a: degrees the cam has turned in its running direction ({sense}) from cam angle 0; "
+        f"the wheel sits on the follower's line through the axis, the ray {ray} of the cam frame",
+        f"# columns: angle_deg radius_mm; {angle.size} rows, step {360.0 / angle.size:.6g} deg, "
+        f"radius {r_dec} decimals",
+    ]
+    lines += [f"{a:.{a_dec}f} {r:.{r_dec}f}" for a, r in zip(degrees, rows, strict=True)]
+    return "\n".join(lines) + "\n"
+
+
+def write_polar_table(path: str | os.PathLike[str], cam: Cam, options: TablesSpec, *, name: str = "") -> Path:
+    """Write ``polar.txt`` (see :func:`polar_table_text`) atomically; return its path."""
+    return write_text(path, polar_table_text(cam, options, name=name))

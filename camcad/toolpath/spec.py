@@ -1,11 +1,13 @@
-"""The toolpath stage's options: the ``[gcode]`` table, the milling direction and the dialect."""
+"""The toolpath stage's options: the ``[gcode]`` table, the milling direction, the dialect and the machine."""
 
 from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Dialect", "Direction", "GcodeSpec"]
+from camcad.geometry.spec import Rotation
+
+__all__ = ["Cutter", "Dialect", "Direction", "GcodeSpec", "Machine", "RotaryAxis"]
 
 
 class Dialect(enum.Enum):
@@ -21,6 +23,27 @@ class Direction(enum.Enum):
 
     CLIMB = "climb"
     CONVENTIONAL = "conventional"
+
+
+class Machine(enum.Enum):
+    """How the cam is cut: contoured on an XY table, or turned past the tool on a rotary axis."""
+
+    XY = "xy"
+    ROTARY = "rotary"
+
+
+class RotaryAxis(enum.Enum):
+    """The letter of the rotary axis the cam turns on (``machine = "rotary"``)."""
+
+    A = "A"
+    C = "C"
+
+
+class Cutter(enum.Enum):
+    """The rotary machine's tool: an end mill on its side (step-downs) or a wheel (one pass)."""
+
+    END_MILL = "end-mill"
+    WHEEL = "wheel"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -47,6 +70,10 @@ class GcodeSpec:
     spindle_rpm: float = 10000.0
     coolant: bool = False
     mill_bore: bool = False
+    machine: Machine = Machine.XY
+    rotary_axis: RotaryAxis = RotaryAxis.A
+    rotary_direction: Rotation = Rotation.CCW  # how the cam turns, seen from +Z, as the rotary word grows
+    cutter: Cutter = Cutter.END_MILL  # rotary machine only
 
     @property
     def tool_radius(self) -> float:

@@ -6,6 +6,10 @@ turns it into text and reads programs back.
 - :func:`render_gcode` writes a :class:`~camcad.toolpath.Toolpath` in a
   dialect (``linuxcnc``, ``grbl``, ``generic``); :func:`render_program` also
   counts the figures for summary.json on the text it rendered.
+- :func:`render_rotary` writes a rotary program (``machine = "rotary"``:
+  X and A or C words in G93 inverse time) of a
+  :class:`~camcad.toolpath.rotary.RotaryToolpath`; :func:`render_rotary_program`
+  also counts its figures.
 - :func:`parse_gcode` and :func:`parse_canon` (LinuxCNC ``rs274`` output)
   read programs back into :class:`~camcad.toolpath.Move` s, for
   :func:`camcad.toolpath.check_toolpath` to prove.
@@ -28,6 +32,7 @@ turns it into text and reads programs back.
 
 from camcad.export.gcode.dialects import DIALECTS, DialectRules, dialect_rules
 from camcad.export.gcode.parse import parse_canon, parse_gcode
+from camcad.export.gcode.rotary import render_rotary, render_rotary_program
 from camcad.export.gcode.writer import (
     GcodeProgram,
     GcodeSummary,
@@ -48,5 +53,7 @@ __all__ = [
     "parse_gcode",
     "render_gcode",
     "render_program",
+    "render_rotary",
+    "render_rotary_program",
     "summarize",
 ]

@@ -12,7 +12,7 @@ import unicodedata
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
-from camcad.export.gcode.dialects import dialect_rules
+from camcad.export.gcode.dialects import DialectRules, dialect_rules
 from camcad.toolpath.moves import MoveKind
 from camcad.toolpath.spec import Dialect, GcodeSpec
 
@@ -80,15 +80,52 @@ def _header(tp: Toolpath, dialect: str) -> list[str]:
         "units: millimetres [G21], feeds mm/min",
         "origin: G54 X0 Y0 on the cam axis, Z0 on top of the stock",
         f"tool: T{s.tool_number} flat end mill D{s.tool_diameter:.3f} (radius {s.tool_radius:.3f})",
-        f"stock: plate {tp.thickness:.3f} thick, cut to Z{-depth:.4f} [breakthrough {s.breakthrough:.3f}]",
-        f"tolerance: {s.tolerance:.4f}, measured contour deviation {tp.max_deviation:.4f}",
-        f"passes: {passes} roughing at offset {tp.rough_offset:.4f}, 1 finishing, {s.direction.value}",
+        *(
+            [
+                f"stock: blank {tp.thickness:.3f} thick, groove cut to Z{-depth:.4f} from the top face",
+                f"tolerance: {s.tolerance:.4f}, measured flank deviation {tp.max_deviation:.4f}",
+                f"passes: slot ramp in {passes} laps + 1 flat lap, 2 flank finishing, {s.direction.value}",
+            ]
+            if tp.operation == "groove"
+            else [
+                f"stock: plate {tp.thickness:.3f} thick, cut to Z{-depth:.4f} "
+                f"[breakthrough {s.breakthrough:.3f}]",
+                f"tolerance: {s.tolerance:.4f}, measured contour deviation {tp.max_deviation:.4f}",
+                f"passes: {passes} roughing at offset {tp.rough_offset:.4f}, 1 finishing, "
+                f"{s.direction.value}",
+            ]
+        ),
         f"heights: clearance Z{s.clearance_height:.3f}, safe Z{s.safe_height:.3f}",
     ]
     if tp.tab_top is not None:
         lines.append(f"tabs: {s.tab_count} x {s.tab_width:.3f} wide, top at Z{tp.tab_top:.4f}")
     lines.extend(tp.notes)
     return [_comment(t) for t in lines]
+
+
+def program_start(s: GcodeSpec, rules: DialectRules) -> list[str]:
+    """The blocks after the header: modal state, blending, tool, length offset, clearance, spindle, coolant.
+
+    Shared by the XY and the rotary writer, so both start a program the same way.
+    """
+    out = [rules.modal]
+    if rules.blend:
+        out.append(f"G64 P{_num(s.tolerance)}")
+    if rules.tool_change:
+        out.append(f"T{s.tool_number} M6")
+    else:
+        out.append(
+            _comment(f"load tool T{s.tool_number}: end mill D{s.tool_diameter:.3f}, set Z0 on the stock top")
+        )
+    if rules.length_offset:
+        out.append(f"G43 H{s.tool_number}")
+    out.append(f"G0 Z{_num(s.clearance_height)}")
+    out.append(f"S{_feed(s.spindle_rpm)} M3")
+    if rules.spindle_dwell:
+        out.append(rules.spindle_dwell)
+    if s.coolant:
+        out.append("M8")
+    return out
 
 
 def render_gcode(toolpath: Toolpath, dialect: Dialect | str | None = None) -> str:
@@ -109,24 +146,7 @@ def render_gcode(toolpath: Toolpath, dialect: Dialect | str | None = None) -> st
     """
     rules = dialect_rules(toolpath.spec.dialect if dialect is None else dialect)
     s: GcodeSpec = toolpath.spec
-    out = _header(toolpath, rules.name)
-    out.append(rules.modal)
-    if rules.blend:
-        out.append(f"G64 P{_num(s.tolerance)}")
-    if rules.tool_change:
-        out.append(f"T{s.tool_number} M6")
-    else:
-        out.append(
-            _comment(f"load tool T{s.tool_number}: end mill D{s.tool_diameter:.3f}, set Z0 on the stock top")
-        )
-    if rules.length_offset:
-        out.append(f"G43 H{s.tool_number}")
-    out.append(f"G0 Z{_num(s.clearance_height)}")
-    out.append(f"S{_feed(s.spindle_rpm)} M3")
-    if rules.spindle_dwell:
-        out.append(rules.spindle_dwell)
-    if s.coolant:
-        out.append("M8")
+    out = _header(toolpath, rules.name) + program_start(s, rules)
     pos: list[float | None] = [None, None, s.clearance_height]
     feed: float | None = None
     for m in toolpath.moves:
