@@ -1,4 +1,19 @@
-"""DXF drawings of the cam: the fitted profile as one exact SPLINE, and a polyline twin.
+"""DXF drawings of the cam: the exact SPLINE drawing, and polyline and arcs files for cutting.
+
+Three files, one for each kind of program (the README's table "which file
+for which program"):
+
+- ``profile.dxf``: the drawing for CAD programs that read splines
+  (LibreCAD, FreeCAD, …): the profile as one exact SPLINE, with the pitch
+  curve, bore, centre lines and notes.
+- ``profile_poly.dxf``: only the cutting contours as closed LWPOLYLINEs
+  without bulges, for laser cutters and OpenSCAD.
+- ``profile_arcs.dxf``: only the cutting contours as tangent-continuous
+  ARCs (and LINEs), within the fit tolerance, for CNC controllers and CAM
+  importers that do not read splines.
+
+No file holds construction geometry as a closed outline: a program that
+extrudes every closed contour it finds (OpenSCAD) extrudes only the part.
 
 ``profile.dxf`` (DXF R2010, millimetres) holds, by layer:
 
@@ -9,8 +24,19 @@
     purpose: CAD programs rebuild fit-point splines with their own end
     conditions, and LibreCAD and ezdxf's renderer misdraw periodic ones.
 ``PITCH_CURVE``
-    Roller followers only (``[dxf].pitch_curve``): the roller-centre path as
-    a closed LWPOLYLINE within ``[dxf].chord_tolerance``.
+    Roller followers only (``[dxf].pitch_curve``): the roller-centre path,
+    dashed by its geometry: open LWPOLYLINE dashes (``PITCH_DASH`` mm long,
+    ``PITCH_GAP`` mm apart, stretched to fit the curve's length), each within
+    ``[dxf].chord_tolerance`` of the curve, linetype Continuous. LibreCAD
+    restarts a linetype pattern at every vertex, so a DASHED closed polyline
+    or spline with short segments prints solid; FreeCAD ignores linetypes;
+    and OpenSCAD would extrude a closed pitch polyline as a part 1.8× too
+    large. Dashes print dashed everywhere and close no outline.
+``GROOVE_INNER``, ``GROOVE_OUTER``, ``BLANK``
+    A groove cam (issue 15) instead of ``CAM_PROFILE``: its inner and outer
+    flank as one SPLINE each (their own certified fits), the pitch curve
+    being the groove's centre line, and the blank's rim as a CIRCLE. The
+    polyline and arcs files hold the same layers.
 ``BORE``
     The bore as a CIRCLE, or bore and keyway as one closed LWPOLYLINE whose
     bore arc is an exact bulge.
@@ -22,19 +48,32 @@
 ``profile_poly.dxf`` holds only the cutting contours, ``CAM_PROFILE`` and
 ``BORE``, as closed LWPOLYLINEs without bulges within
 ``[dxf].chord_tolerance``, for laser cutters and OpenSCAD, which ignore
-splines and arcs. The pitch curve, centre lines and text are left out so a
-cutter does not cut them.
+splines. ``profile_arcs.dxf`` holds the same two layers as ARC and LINE
+entities: the profile as biarcs within the fit tolerance
+(:func:`~camcad.export._outline.arc_outline`), the bore as a CIRCLE, or four
+LINEs and one ARC with its keyway. The pitch curve, centre lines and text are
+left out of both so a cutter does not cut them.
 
-Both documents are audited before saving; an audit error raises
+Every file has ``$EXTMIN``/``$EXTMAX`` and ``$LIMMIN``/``$LIMMAX`` set to
+the drawing's extents and its initial view framed on them (not ezdxf's
+±1e20 and 1000 mm defaults). More closed outlines (a groove's flanks, a
+second plate) go on layers of their own through the same helpers
+(``_add_profile_spline``, ``_add_closed_polyline``, ``_add_arcs``, each
+taking a layer name) and a line in ``LAYERS``.
+
+Every document is audited before saving; an audit error raises
 :class:`~camcad.errors.ExportError` and nothing is written.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import re
 import unicodedata
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -48,14 +87,14 @@ from ezdxf.document import Drawing
 from ezdxf.layouts import Modelspace
 
 from camcad.errors import ExportError
-from camcad.export._outline import flatten_bspline, flatten_curve
+from camcad.export._outline import arc_outline, flatten_bspline, flatten_curve
 from camcad.export.atomic import atomic_write
 from camcad.export.spec import DxfSpec
 from camcad.fit.curve import BSplineCurve
 from camcad.fit.result import ProfileFit
-from camcad.geometry.plate import BoreOutline, Plate
-from camcad.geometry.spec import FollowerKind
+from camcad.geometry.plate import BoreOutline, Plate, circle_segments
 from camcad.motion.segments import SegmentKind
+from camcad.toolpath.arcs.biarc import Pieces
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -63,9 +102,13 @@ if TYPE_CHECKING:
 __all__ = [
     "DXF_VERSION",
     "LAYERS",
+    "DxfCurve",
     "dxf_text",
+    "pitch_dashes",
+    "profile_arcs_document",
     "profile_document",
     "profile_poly_document",
+    "write_profile_arcs_dxf",
     "write_profile_dxf",
     "write_profile_poly_dxf",
 ]
@@ -75,15 +118,46 @@ INSUNITS_MM = 4  # $INSUNITS code for millimetres
 MEASUREMENT_METRIC = 1  # $MEASUREMENT: metric linetype and hatch patterns
 TEXT_HEIGHT = 2.5  # mm, ISO 3098 lettering
 CENTER_OVERHANG = 5.0  # mm beyond the largest profile radius
+PITCH_DASH = 3.0  # mm, dash of the pitch curve (ISO 128-20 dashed line: dash 12 d, gap 3 d, d = 0.25 mm)
+PITCH_GAP = 0.75  # mm
+MIN_DASHES = 24  # a small cam still shows a dashed curve
+TEXT_WIDTH = 1.0  # character width / height, a generous bound for the drawing's extents (no font metrics)
+VIEW_MARGIN = 5.0  # mm around the extents in the initial view
 
 # layer name: (ACI colour, linetype)
 LAYERS: dict[str, tuple[int, str]] = {
     "CAM_PROFILE": (7, "Continuous"),
-    "PITCH_CURVE": (3, "DASHED"),
+    "GROOVE_INNER": (7, "Continuous"),  # a groove cam's flanks (issue 15)
+    "GROOVE_OUTER": (5, "Continuous"),
+    "BLANK": (8, "Continuous"),  # a groove cam's blank
+    "PITCH_CURVE": (3, "Continuous"),  # dashed by its geometry (see the module docstring)
     "BORE": (1, "Continuous"),
     "CENTER": (4, "CENTER"),
     "ANNOTATION": (2, "Continuous"),
 }
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DxfCurve:
+    """One certified closed curve of a drawing: its layer, its fit, and the exact curve it stands for.
+
+    The exact curve is ``cam.offset(φ, offset)``: the profile for ``offset = 0``,
+    a groove's flank for the offsets of :func:`camcad.geometry.groove.flank_offsets`.
+    """
+
+    layer: str
+    fit: ProfileFit
+    offset: float = 0.0
+
+
+def _curves(fit: ProfileFit, curves: Sequence[DxfCurve] | None) -> Sequence[DxfCurve]:
+    return curves if curves is not None else (DxfCurve(layer="CAM_PROFILE", fit=fit),)
+
+
+def _add_blank(msp: Modelspace, radius: float | None) -> None:
+    """A groove cam's blank outline as one CIRCLE on layer BLANK."""
+    if radius is not None:
+        msp.add_circle((0.0, 0.0), radius, dxfattribs={"layer": "BLANK"})
 
 
 def _new_document() -> tuple[Drawing, Modelspace]:
@@ -119,10 +193,10 @@ def _check_clamped(curve: BSplineCurve) -> None:
         )
 
 
-def _add_profile_spline(msp: Modelspace, curve: BSplineCurve) -> None:
+def _add_profile_spline(msp: Modelspace, curve: BSplineCurve, layer: str = "CAM_PROFILE") -> None:
     """One SPLINE from control points and knots: non-rational, flags 0, no fit points."""
     _check_clamped(curve)
-    spline = msp.add_spline(degree=curve.degree, dxfattribs={"layer": "CAM_PROFILE"})
+    spline = msp.add_spline(degree=curve.degree, dxfattribs={"layer": layer})
     spline.dxf.flags = 0
     spline.control_points = [(float(x), float(y), 0.0) for x, y in curve.control_points]  # type: ignore[assignment]
     spline.knots = [float(k) for k in curve.knots]  # type: ignore[assignment]
@@ -142,6 +216,91 @@ def _add_bore_exact(msp: Modelspace, bore: BoreOutline) -> None:
         msp.add_circle((0.0, 0.0), bore.radius, dxfattribs={"layer": "BORE"})
         return
     msp.add_lwpolyline(bore.bulge_vertices(), format="xyb", close=True, dxfattribs={"layer": "BORE"})
+
+
+def _add_arcs(msp: Modelspace, pieces: Pieces, layer: str) -> None:
+    """ARC and LINE entities of biarc pieces (empty pieces skipped); an ARC runs ccw, so cw arcs swap ends."""
+    attribs = {"layer": layer}
+    for k in range(len(pieces)):
+        for j in range(2):
+            start, end = pieces.start[k, j], pieces.end[k, j]
+            if np.array_equal(start, end):
+                continue
+            if pieces.line[k, j]:
+                msp.add_line(tuple(map(float, start)), tuple(map(float, end)), dxfattribs=attribs)
+                continue
+            centre = pieces.center[k, j]
+            a0 = math.degrees(math.atan2(start[1] - centre[1], start[0] - centre[0]))
+            a1 = math.degrees(math.atan2(end[1] - centre[1], end[0] - centre[0]))
+            if not pieces.ccw[k, j]:
+                a0, a1 = a1, a0
+            msp.add_arc(
+                (float(centre[0]), float(centre[1])), float(pieces.r_start[k, j]), a0, a1, dxfattribs=attribs
+            )
+
+
+def _add_bore_arcs(msp: Modelspace, bore: BoreOutline) -> None:
+    """The bore as a CIRCLE, or its keyway as four LINEs and the bore as one ARC (no bulges)."""
+    if not bore.has_keyway:
+        msp.add_circle((0.0, 0.0), bore.radius, dxfattribs={"layer": "BORE"})
+        return
+    corners = [(x, y) for x, y, _ in bore.bulge_vertices()]
+    for a, b in itertools.pairwise(corners):
+        msp.add_line(a, b, dxfattribs={"layer": "BORE"})
+    # the bore arc runs ccw from the last corner (−w/2, y₀) round the bottom to the first (w/2, y₀)
+    a0 = math.degrees(math.atan2(corners[-1][1], corners[-1][0]))
+    a1 = math.degrees(math.atan2(corners[0][1], corners[0][0]))
+    msp.add_arc((0.0, 0.0), bore.radius, a0, a1, dxfattribs={"layer": "BORE"})
+
+
+def pitch_dashes(points: np.ndarray) -> list[np.ndarray]:
+    """A closed polyline cut into dashes: ``PITCH_DASH`` on, ``PITCH_GAP`` off, stretched to close evenly.
+
+    Parameters
+    ----------
+    points
+        (n, 2) vertices of a closed polyline [mm], the first not repeated.
+
+    Returns
+    -------
+    list[np.ndarray]
+        One (m, 2) open polyline per dash [mm]; its ends lie on the polyline
+        (linear interpolation between vertices), its inner points are vertices.
+    """
+    ring = np.vstack((points, points[:1]))
+    along = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))))
+    length = float(along[-1])
+    count = max(MIN_DASHES, round(length / (PITCH_DASH + PITCH_GAP)))
+    period = length / count
+    on = period * PITCH_DASH / (PITCH_DASH + PITCH_GAP)
+    dashes = []
+    for k in range(count):
+        a, b = k * period, k * period + on
+        inner = (along > a) & (along < b)
+        ends = np.column_stack([np.interp([a, b], along, ring[:, i]) for i in range(2)])
+        dashes.append(np.vstack((ends[:1], ring[inner], ends[1:])))
+    return dashes
+
+
+def _add_dashes(msp: Modelspace, dashes: list[np.ndarray], layer: str) -> None:
+    for dash in dashes:
+        msp.add_lwpolyline([(float(x), float(y)) for x, y in dash], format="xy", dxfattribs={"layer": layer})
+
+
+def _frame(doc: Drawing, box: tuple[float, float, float, float]) -> None:
+    """Set the drawing's extents and limits to ``box`` (xmin, ymin, xmax, ymax) [mm] and frame the view."""
+    x0, y0, x1, y1 = (float(v) for v in box)
+    msp = doc.modelspace()  # ezdxf copies the model space layout's extents and limits to the header on save
+    msp.reset_extents((x0, y0, 0.0), (x1, y1, 0.0))
+    msp.reset_limits((x0, y0), (x1, y1))
+    zoom.window(msp, (x0 - VIEW_MARGIN, y0 - VIEW_MARGIN), (x1 + VIEW_MARGIN, y1 + VIEW_MARGIN))
+
+
+def _box(points: np.ndarray, bore: BoreOutline | None) -> tuple[float, float, float, float]:
+    """Bounding box of an outline's vertices and a bore (its reach from the axis) [mm]."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    reach = bore.reach if bore is not None else 0.0
+    return (min(lo[0], -reach), min(lo[1], -reach), max(hi[0], reach), max(hi[1], reach))
 
 
 def _add_center_lines(msp: Modelspace, reach: float) -> None:
@@ -173,7 +332,7 @@ def dxf_text(text: str) -> str:
     return plain
 
 
-def _annotation_lines(cam: Cam, plate: Plate, fit: ProfileFit) -> list[str]:
+def _annotation_lines(cam: Cam, plate: Plate, curves: Sequence[DxfCurve]) -> list[str]:
     """Plain-ASCII lines of the annotation block."""
     follower, bore = cam.follower, plate.bore
     sizes = f"base radius {cam.base_radius:.3f} mm, thickness {plate.thickness:.3f} mm"
@@ -181,36 +340,33 @@ def _annotation_lines(cam: Cam, plate: Plate, fit: ProfileFit) -> list[str]:
         sizes += f", bore dia {2.0 * bore.radius:.3f} mm"
         if bore.has_keyway:
             sizes += f", keyway {bore.keyway_width:.3f} x {bore.keyway_depth:.3f} mm"
-    if follower.kind is FollowerKind.TRANSLATING_ROLLER:
-        who = f"roller radius {follower.roller_radius:.3f} mm"
-    else:
-        who = "flat face" + (
-            f" width {follower.face_width:.3f} mm" if follower.face_width is not None else ""
-        )
-    lines = [
-        f"CAM {plate.name}",
-        sizes,
-        f"follower {follower.kind.value}, {who}, offset {follower.eccentricity:.3f} mm, "
-        f"rotation {cam.rotation.value}",
-    ]
+    who = cam.kinematics.describe()
+    if not follower.kind.roller and follower.face_width is not None:
+        who += f", face width {follower.face_width:.3f} mm"
+    who = f"follower {follower.kind.value}: {who}, rotation {cam.rotation.value}"
+    lines = [f"CAM {plate.name}", sizes, who]
     for seg in cam.program.segments:
         span = f"{math.degrees(seg.span):.3f} deg"
         if seg.kind is SegmentKind.DWELL or seg.law is None:
             lines.append(f"{seg.kind.value} {span}")
         else:
             lines.append(f"{seg.kind.value} {span}, lift {seg.lift:.3f} mm, {seg.law.describe()}")
-    lines.append(f"profile spline: fit tolerance {fit.tolerance:.4g} mm, max error {fit.max_error:.3g} mm")
+    for curve in curves:
+        what = "profile" if curve.layer == "CAM_PROFILE" else curve.layer.lower().replace("_", " ")
+        fit = curve.fit
+        lines.append(f"{what} spline: fit tolerance {fit.tolerance:.4g} mm, max error {fit.max_error:.3g} mm")
     lines.append("units mm")
     return [dxf_text(line) for line in lines]
 
 
-def _add_annotation(msp: Modelspace, lines: list[str], reach: float) -> float:
-    """TEXT lines below the cam; returns the lowest y used [mm]."""
+def _add_annotation(msp: Modelspace, lines: list[str], reach: float) -> tuple[float, float]:
+    """TEXT lines below the cam; the lowest y used and the largest x the text may reach [mm]."""
     y = -reach - 2.0 * TEXT_HEIGHT
     for line in lines:
         y -= 1.6 * TEXT_HEIGHT
         msp.add_text(line, height=TEXT_HEIGHT, dxfattribs={"layer": "ANNOTATION"}).set_placement((-reach, y))
-    return y
+    widest = max((len(line) for line in lines), default=0) * TEXT_WIDTH * TEXT_HEIGHT
+    return y, -reach + widest
 
 
 def _audited(doc: Drawing, name: str) -> Drawing:
@@ -221,7 +377,15 @@ def _audited(doc: Drawing, name: str) -> Drawing:
     return doc
 
 
-def profile_document(*, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpec) -> Drawing:
+def profile_document(
+    *,
+    cam: Cam,
+    fit: ProfileFit,
+    plate: Plate,
+    options: DxfSpec,
+    curves: Sequence[DxfCurve] | None = None,
+    blank_radius: float | None = None,
+) -> Drawing:
     """Build the ``profile.dxf`` document (not saved); see the module docstring for layers.
 
     Parameters
@@ -234,6 +398,11 @@ def profile_document(*, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpe
         Name, thickness, bore and keyway.
     options
         ``[dxf]`` settings.
+    curves
+        The closed curves to draw, each a SPLINE on its own layer (a
+        groove's flanks); default: ``fit`` as the profile on ``CAM_PROFILE``.
+    blank_radius
+        A groove cam's blank [mm], drawn as a CIRCLE on ``BLANK``.
 
     Raises
     ------
@@ -241,69 +410,136 @@ def profile_document(*, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpe
         When the fit is not a closed clamped spline or the audit fails.
     """
     doc, msp = _new_document()
-    _add_profile_spline(msp, fit.clamped)
-    outline = flatten_bspline(fit.clamped, options.chord_tolerance)
-    reach = float(np.max(np.hypot(outline[:, 0], outline[:, 1])))
+    reach = 0.0
+    for curve in _curves(fit, curves):
+        _add_profile_spline(msp, curve.fit.clamped, curve.layer)
+        outline = flatten_bspline(curve.fit.clamped, options.chord_tolerance)
+        reach = max(reach, float(np.max(np.hypot(outline[:, 0], outline[:, 1]))))
+    _add_blank(msp, blank_radius)
+    reach = max(reach, blank_radius or 0.0)
     if options.pitch_curve and cam.is_roller:
-        breaks = [b.phi for b in cam.program.breakpoints]
+        breaks = list(cam.program.pieces)
         pitch = flatten_curve(cam.pitch, options.chord_tolerance, breakpoints=breaks)
-        _add_closed_polyline(msp, pitch, "PITCH_CURVE")
+        _add_dashes(msp, pitch_dashes(pitch), "PITCH_CURVE")
         reach = max(reach, float(np.max(np.hypot(pitch[:, 0], pitch[:, 1]))))
     bore = plate.bore
     if bore is not None:
         _add_bore_exact(msp, bore)
     reach += CENTER_OVERHANG
     _add_center_lines(msp, reach)
-    bottom = -reach
+    bottom, right = -reach, reach
     if options.annotate:
-        bottom = _add_annotation(msp, _annotation_lines(cam, plate, fit), reach) - TEXT_HEIGHT
-    zoom.window(msp, (-reach - 5.0, bottom - 5.0), (reach + 5.0, reach + 5.0))
+        low, widest = _add_annotation(msp, _annotation_lines(cam, plate, _curves(fit, curves)), reach)
+        bottom, right = low - TEXT_HEIGHT, max(reach, widest)
+    _frame(doc, (-reach, bottom, right, reach))
     return _audited(doc, "profile.dxf")
 
 
-def profile_poly_document(*, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpec) -> Drawing:
-    """Build the ``profile_poly.dxf`` document: profile and bore as bulge-free LWPOLYLINEs.
+def profile_poly_document(
+    *,
+    cam: Cam,
+    fit: ProfileFit,
+    plate: Plate,
+    options: DxfSpec,
+    curves: Sequence[DxfCurve] | None = None,
+    blank_radius: float | None = None,
+) -> Drawing:
+    """Build the ``profile_poly.dxf`` document: profile (or ``curves``) and bore as bulge-free LWPOLYLINEs.
 
-    The profile is flattened from ``fit.clamped`` with a chord error bound of
-    ``[dxf].chord_tolerance``; the bore polygon is inscribed in the circle
-    within the same tolerance with exact keyway corners. ``cam`` is accepted
-    for a uniform signature and not used.
+    Each curve is flattened from its fit's clamped spline with a chord error
+    bound of ``[dxf].chord_tolerance``; the bore polygon (and a groove cam's
+    blank) is inscribed in its circle within the same tolerance, with exact
+    keyway corners. ``cam`` is accepted for a uniform signature and not used.
     """
     del cam
     doc, msp = _new_document()
     tol = options.chord_tolerance
-    _add_closed_polyline(msp, flatten_bspline(fit.clamped, tol), "CAM_PROFILE")
+    outlines = [flatten_bspline(c.fit.clamped, tol) for c in _curves(fit, curves)]
+    for curve, outline in zip(_curves(fit, curves), outlines, strict=True):
+        _add_closed_polyline(msp, outline, curve.layer)
+    if blank_radius is not None:
+        n = circle_segments(blank_radius, tol)
+        angle = np.arange(n) * (2.0 * math.pi / n)
+        rim = blank_radius * np.column_stack((np.cos(angle), np.sin(angle)))
+        _add_closed_polyline(msp, rim, "BLANK")
+        outlines.append(rim)
     bore = plate.bore
     if bore is not None:
         _add_closed_polyline(msp, bore.polygon(tol), "BORE")
+    _frame(doc, _box(np.vstack(outlines), bore))
     return _audited(doc, "profile_poly.dxf")
+
+
+def profile_arcs_document(
+    *,
+    cam: Cam,
+    fit: ProfileFit,
+    plate: Plate,
+    options: DxfSpec,
+    curves: Sequence[DxfCurve] | None = None,
+    blank_radius: float | None = None,
+) -> Drawing:
+    """Build the ``profile_arcs.dxf`` document: the profile as tangent arcs, the bore as ARC/LINE/CIRCLE.
+
+    The arcs are biarcs through the exact profile ``cam.offset(φ, 0)``
+    within the fit tolerance ``fit.tolerance``, measured two-way
+    (:func:`~camcad.export._outline.arc_outline`); consecutive arcs share end
+    points and tangents. ``options`` is accepted for a uniform signature.
+    """
+    del options
+    doc, msp = _new_document()
+    pad, boxes = 0.0, []
+    for curve in _curves(fit, curves):
+
+        def exact(phi: np.ndarray, d: float = curve.offset) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            o = cam.offset(phi, d)
+            return o.point, o.d1, o.d2
+
+        tol = curve.fit.tolerance
+        try:
+            pieces, _ = arc_outline(exact, list(cam.program.pieces), tol)
+        except ValueError as err:  # a corner in the profile: a velocity jump, refused earlier as a hard limit
+            raise ExportError(f"profile_arcs.dxf: {err}") from err
+        _add_arcs(msp, pieces, curve.layer)
+        # the arcs lie within the tolerance of the exact curve, which lies within max_error of the spline
+        boxes.append(flatten_bspline(curve.fit.clamped, tol))
+        pad = max(pad, tol + curve.fit.max_error)
+    if blank_radius is not None:
+        _add_blank(msp, blank_radius)
+        boxes.append(np.array([[-blank_radius, -blank_radius], [blank_radius, blank_radius]]) * (1.0 - pad))
+    bore = plate.bore
+    if bore is not None:
+        _add_bore_arcs(msp, bore)
+    x0, y0, x1, y1 = _box(np.vstack(boxes), bore)
+    _frame(doc, (x0 - pad, y0 - pad, x1 + pad, y1 + pad))
+    return _audited(doc, "profile_arcs.dxf")
 
 
 def _save(doc: Drawing, path: str | os.PathLike[str]) -> Path:
     return atomic_write(path, lambda tmp: save_reproducible(doc, tmp))
 
 
-def write_profile_dxf(
-    path: str | os.PathLike[str], *, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpec
-) -> Path:
-    """Write ``profile.dxf`` atomically; see :func:`profile_document`.
+def _writer(build: Callable[..., Drawing], name: str) -> Callable[..., Path]:
+    """The atomic file writer of one document builder (the three share their keywords)."""
 
-    Returns
-    -------
-    Path
-        The written file.
-    """
-    return _save(profile_document(cam=cam, fit=fit, plate=plate, options=options), path)
+    def write(
+        path: str | os.PathLike[str],
+        *,
+        cam: Cam,
+        fit: ProfileFit,
+        plate: Plate,
+        options: DxfSpec,
+        curves: Sequence[DxfCurve] | None = None,
+        blank_radius: float | None = None,
+    ) -> Path:
+        doc = build(cam=cam, fit=fit, plate=plate, options=options, curves=curves, blank_radius=blank_radius)
+        return _save(doc, path)
+
+    write.__name__ = write.__qualname__ = f"write_{name}_dxf"
+    write.__doc__ = f"Write ``{name}.dxf`` atomically and return its path; see :func:`{build.__name__}`."
+    return write
 
 
-def write_profile_poly_dxf(
-    path: str | os.PathLike[str], *, cam: Cam, fit: ProfileFit, plate: Plate, options: DxfSpec
-) -> Path:
-    """Write ``profile_poly.dxf`` atomically; see :func:`profile_poly_document`.
-
-    Returns
-    -------
-    Path
-        The written file.
-    """
-    return _save(profile_poly_document(cam=cam, fit=fit, plate=plate, options=options), path)
+write_profile_dxf = _writer(profile_document, "profile")
+write_profile_arcs_dxf = _writer(profile_arcs_document, "profile_arcs")
+write_profile_poly_dxf = _writer(profile_poly_document, "profile_poly")

@@ -1,4 +1,10 @@
-"""DXF export: read back with ezdxf.recover and compared by meaning, not bytes."""
+"""DXF export: read back with ezdxf.recover and compared by meaning, not bytes.
+
+Independent truths: the exact profile and pitch curve (``cam.profile``,
+``cam.pitch``), the fit's control points and knots, closed-form bore areas,
+exact arc geometry sampled here (not by the writer), ezdxf's own bounding
+boxes for the extents.
+"""
 
 from __future__ import annotations
 
@@ -13,13 +19,17 @@ from ezdxf import recover
 from ezdxf.entitydb import EntityDB
 from ezdxf.math import bulge_to_arc
 from numpy.testing import assert_allclose
-from scipy.spatial import cKDTree
 
 from camcad.design import Design
 from camcad.errors import ExportError
-from camcad.export._outline import flatten_bspline, polygon_area
+from camcad.export._outline import bspline_area, bspline_length, flatten_bspline, polygon_area
 from camcad.export.dxf import (
+    PITCH_DASH,
+    PITCH_GAP,
+    profile_arcs_document,
     profile_document,
+    profile_poly_document,
+    write_profile_arcs_dxf,
     write_profile_dxf,
     write_profile_poly_dxf,
 )
@@ -74,12 +84,13 @@ def case(request: pytest.FixtureRequest) -> tuple[Design, Cam, ProfileFit]:
 
 
 @pytest.fixture(scope="module")
-def written(case, tmp_path_factory) -> tuple[Path, Path]:
+def written(case, tmp_path_factory) -> tuple[Path, Path, Path]:
     design, cam, fit = case
     folder = tmp_path_factory.mktemp("dxf")
     return (
         write_profile_dxf(folder / "profile.dxf", cam=cam, fit=fit, **writer_options(design)),
         write_profile_poly_dxf(folder / "profile_poly.dxf", cam=cam, fit=fit, **writer_options(design)),
+        write_profile_arcs_dxf(folder / "profile_arcs.dxf", cam=cam, fit=fit, **writer_options(design)),
     )
 
 
@@ -177,19 +188,33 @@ def test_centre_lines_and_pitch_curve(case, written):
     lines = msp.query('LINE[layer=="CENTER"]')
     assert len(lines) == 2
     assert all(line.dxf.start.isclose(-line.dxf.end) for line in lines)  # through the cam axis
-    pitch = msp.query('LWPOLYLINE[layer=="PITCH_CURVE"]')
+    pitch = msp.query('*[layer=="PITCH_CURVE"]')
     if not cam.is_roller:
         assert len(pitch) == 0
         return
-    assert len(pitch) == 1 and pitch[0].closed
-    pts = np.asarray(pitch[0].get_points("xy"))
-    exact = cam.pitch(cam.sample_phi()).point
-    _, nearest = cKDTree(exact).query(pts)
-    assert_allclose(pts, exact[nearest], rtol=0, atol=0.5)  # vertices lie on the pitch curve
+    # dashed by geometry: open polylines, no closed outline a program could extrude
+    assert {e.dxftype() for e in pitch} == {"LWPOLYLINE"}
+    assert not any(e.closed for e in pitch)
+    dashes = [np.asarray(e.get_points("xy")) for e in pitch]
+    exact = cam.pitch(np.linspace(0.0, 2.0 * math.pi, 400001)[:-1]).point
+    pts = np.vstack(dashes)
+    # every vertex (dash ends interpolated on chords) within the chord tolerance of the exact curve
+    assert distance_to_polygon(pts, exact).max() <= design.dxf.chord_tolerance + 1e-6
+    # dash and gap lengths: the ISO ratio, stretched evenly round the curve
+    on = np.array([np.sum(np.linalg.norm(np.diff(d, axis=0), axis=1)) for d in dashes])
+    gaps = np.linalg.norm(
+        np.array([b[0] - a[-1] for a, b in zip(dashes, dashes[1:] + dashes[:1], strict=True)]), axis=1
+    )
+    period = on + gaps
+    assert_allclose(period, period.mean(), rtol=1e-3)
+    assert_allclose(on / period, PITCH_DASH / (PITCH_DASH + PITCH_GAP), rtol=1e-3)
+    assert period.mean() == pytest.approx(PITCH_DASH + PITCH_GAP, rel=0.2)
+    # together they follow the whole curve: largest and smallest radius reached
     radius = np.hypot(pts[:, 0], pts[:, 1])
     prime = design.cam.base_radius + design.follower.roller_radius
-    assert radius.max() == pytest.approx(np.hypot(exact[:, 0], exact[:, 1]).max(), abs=1e-3)
-    assert radius.min() >= np.sqrt(prime**2 - design.follower.eccentricity**2) - 1e-9
+    assert radius.max() == pytest.approx(np.hypot(exact[:, 0], exact[:, 1]).max(), abs=0.05)
+    # dash ends lie on chords: inside the curve by at most the chord tolerance
+    assert radius.min() >= np.sqrt(prime**2 - design.follower.eccentricity**2) - design.dxf.chord_tolerance
 
 
 def test_pitch_curve_and_annotation_can_be_switched_off(case):
@@ -250,3 +275,133 @@ def test_the_same_drawing_gives_the_same_bytes(case, tmp_path, monkeypatch, orde
 
     assert header("$FINGERPRINTGUID") == header("$VERSIONGUID") == "{00000000-0000-0000-0000-000000000000}"
     assert header("$TDCREATE") == header("$TDUPDATE")
+
+
+def arc_points(entity, samples: int = 2000) -> np.ndarray:
+    """Points along an ARC (counter-clockwise from its start angle) or a LINE, sampled here."""
+    if entity.dxftype() == "LINE":
+        a, b = np.asarray(entity.dxf.start)[:2], np.asarray(entity.dxf.end)[:2]
+        return a + (b - a) * np.linspace(0.0, 1.0, samples)[:, None]
+    c, r = np.asarray(entity.dxf.center)[:2], entity.dxf.radius
+    a0, a1 = math.radians(entity.dxf.start_angle), math.radians(entity.dxf.end_angle)
+    t = a0 + np.mod(a1 - a0, 2.0 * math.pi) * np.linspace(0.0, 1.0, samples)
+    return c + r * np.column_stack((np.cos(t), np.sin(t)))
+
+
+def chain(entities) -> list[np.ndarray]:
+    """ARC/LINE entities as point runs ordered end to start, each oriented to follow its neighbour."""
+    runs = [arc_points(e) for e in entities]
+    ordered = [runs.pop(0)]
+    while runs:
+        tail = ordered[-1][-1]
+        k = int(np.argmin([min(np.linalg.norm(r[0] - tail), np.linalg.norm(r[-1] - tail)) for r in runs]))
+        run = runs.pop(k)
+        ordered.append(run if np.linalg.norm(run[0] - tail) <= np.linalg.norm(run[-1] - tail) else run[::-1])
+    return ordered
+
+
+def test_arcs_dxf_holds_tangent_arcs_within_the_fit_tolerance(case, written):
+    """Two-way distance to the exact profile, G1 joints, and the area the arcs enclose."""
+    design, cam, fit = case
+    msp = read_back(written[2]).modelspace()
+    assert {e.dxftype() for e in msp} <= {"ARC", "LINE", "CIRCLE"}
+    assert {e.dxf.layer for e in msp} == ({"CAM_PROFILE", "BORE"} if design.cam.bore > 0 else {"CAM_PROFILE"})
+    profile = [e for e in msp if e.dxf.layer == "CAM_PROFILE"]
+    assert 8 <= len(profile) <= 400
+    runs = chain(profile)
+
+    # closed, every joint shared and tangent (G1)
+    def tangent(run: np.ndarray, at_end: bool) -> np.ndarray:
+        """Exact unit tangent at a run's end (or start), along the run: ⟂ to the radius of its circle."""
+        i, j = (-1, -2) if at_end else (0, 1)
+        chord = (run[i] - run[j]) if at_end else (run[j] - run[i])
+        mid = run[len(run) // 2]
+        # the circle through the run's ends and middle (a line when they are collinear)
+        (x1, y1), (x2, y2), (x3, y3) = run[0], mid, run[-1]
+        d = 2.0 * (x1 * (y2 - y3) + x2 * (y3 - y1) + x3 * (y1 - y2))
+        if abs(d) < 1e-12:
+            return chord / np.linalg.norm(chord)
+        ux = ((x1**2 + y1**2) * (y2 - y3) + (x2**2 + y2**2) * (y3 - y1) + (x3**2 + y3**2) * (y1 - y2)) / d
+        uy = ((x1**2 + y1**2) * (x3 - x2) + (x2**2 + y2**2) * (x1 - x3) + (x3**2 + y3**2) * (x2 - x1)) / d
+        radial = run[i] - (ux, uy)
+        t = np.array([-radial[1], radial[0]]) / np.linalg.norm(radial)
+        return t if np.dot(t, chord) > 0 else -t
+
+    for a, b in zip(runs, runs[1:] + runs[:1], strict=True):
+        assert np.linalg.norm(a[-1] - b[0]) <= 1e-9
+        ta, tb = tangent(a, True), tangent(b, False)
+        assert abs(math.atan2(ta[0] * tb[1] - ta[1] * tb[0], float(np.dot(ta, tb)))) <= 1e-6  # G1
+    pts = np.vstack([r[:-1] for r in runs])
+    exact = cam.profile(np.linspace(0.0, 2.0 * math.pi, 400001)[:-1]).point
+    tol = fit.tolerance
+    assert distance_to_polygon(pts, exact).max() <= tol  # arcs → exact curve
+    assert distance_to_polygon(exact[::20], pts).max() <= tol + 1e-6  # exact curve → arcs (sampled chords)
+    # the enclosed area: polygon of the dense arc samples plus the chord-sagitta correction, vs the spline's
+    area = abs(polygon_area(pts))
+    assert area == pytest.approx(abs(bspline_area(fit.clamped)), abs=2.0 * tol * bspline_length(fit.clamped))
+
+
+def test_arcs_dxf_bore_is_exact(case, written):
+    design, _, _ = case
+    msp = read_back(written[2]).modelspace()
+    bore = BoreOutline.from_cam_spec(design.cam.bore, design.cam.keyway_width, design.cam.keyway_depth)
+    entities = [e for e in msp if e.dxf.layer == "BORE"]
+    if bore is None:
+        assert entities == []
+    elif not bore.has_keyway:
+        assert [e.dxftype() for e in entities] == ["CIRCLE"]
+        assert entities[0].dxf.radius == bore.radius
+    else:
+        assert sorted(e.dxftype() for e in entities) == ["ARC", "LINE", "LINE", "LINE"]
+        outline = np.vstack([r[:-1] for r in chain(entities)])
+        arc = next(e for e in entities if e.dxftype() == "ARC")
+        assert arc.dxf.radius == bore.radius
+        # the sampled arc's 1999 chords cut off (r²/2)(Δ − sin Δ) each: add it back
+        sweep = math.radians(np.mod(arc.dxf.end_angle - arc.dxf.start_angle, 360.0))
+        delta = sweep / 1999
+        segments = 1999 * 0.5 * bore.radius**2 * (delta - math.sin(delta))
+        assert abs(polygon_area(outline)) + segments == pytest.approx(bore.area, rel=1e-12)
+
+
+@pytest.mark.parametrize("index", [0, 1, 2], ids=["profile", "poly", "arcs"])
+def test_extents_limits_and_view_frame_the_drawing(case, written, index):
+    """$EXTMIN/$EXTMAX against ezdxf's own bounding box of the entities (text excluded: no font metrics)."""
+    from ezdxf import bbox
+
+    doc = read_back(written[index])
+    lo, hi = np.asarray(doc.header["$EXTMIN"])[:2], np.asarray(doc.header["$EXTMAX"])[:2]
+    shapes = bbox.extents(e for e in doc.modelspace() if e.dxftype() != "TEXT")
+    assert np.all(lo <= np.asarray(shapes.extmin)[:2] + 1e-6)
+    assert np.all(hi >= np.asarray(shapes.extmax)[:2] - 1e-6)
+    if index > 0:  # cutting files: the extents are the contours' box, within the chord tolerance
+        assert_allclose(lo, np.asarray(shapes.extmin)[:2], atol=0.01)
+        assert_allclose(hi, np.asarray(shapes.extmax)[:2], atol=0.01)
+    assert np.all(np.abs(np.concatenate((lo, hi))) < 1e4)  # not ezdxf's ±1e20 defaults
+    assert_allclose(doc.header["$LIMMIN"], lo)
+    assert_allclose(doc.header["$LIMMAX"], hi)
+    view = doc.viewports.get("*Active")[0]
+    centre, height = np.asarray(view.dxf.center)[:2], view.dxf.height
+    assert_allclose(centre, 0.5 * (lo + hi), atol=1e-9)
+    assert hi[1] - lo[1] < height <= hi[1] - lo[1] + 20.0  # the whole drawing, not a 1000 mm window
+
+
+def test_no_file_holds_construction_geometry_as_a_closed_outline(written):
+    """What a program extruding every closed contour (OpenSCAD) would take: only the part's contours."""
+    for path in written:
+        msp = read_back(path).modelspace()
+        closed = [e for e in msp.query("LWPOLYLINE POLYLINE CIRCLE") if e.dxftype() == "CIRCLE" or e.closed]
+        assert {e.dxf.layer for e in closed} <= {"CAM_PROFILE", "BORE"}
+
+
+@pytest.mark.parametrize(
+    "build", [profile_document, profile_poly_document, profile_arcs_document], ids=["profile", "poly", "arcs"]
+)
+def test_every_dxf_is_the_same_bytes_twice(case, tmp_path, build):
+    from camcad.export._ezdxf import save_reproducible
+
+    design, cam, fit = case
+    paths = []
+    for name in ("a.dxf", "b.dxf"):
+        save_reproducible(build(cam=cam, fit=fit, **writer_options(design)), tmp_path / name)
+        paths.append(tmp_path / name)
+    assert paths[0].read_bytes() == paths[1].read_bytes()

@@ -1,4 +1,5 @@
-"""OpenSCAD extrudes the polyline DXF to the expected volume and takes cam.stl into CGAL."""
+"""OpenSCAD extrudes the polyline and arcs DXFs to the expected volume, takes cam.stl into CGAL, and
+finds no closed construction outline in profile.dxf."""
 
 from __future__ import annotations
 
@@ -78,3 +79,105 @@ def test_cam_stl_is_a_simple_solid_in_a_cgal_difference(built: Built, tmp_path):
     assert cut.volume == pytest.approx(built.solid.volume - hole * t, rel=1e-6)
     holes = built.solid.holes + 1
     assert cut.euler_number == 2 - 2 * holes
+
+
+ARC_FN = 3600  # $fn for the arcs file: OpenSCAD cuts an arc of sweep θ into ceil(ARC_FN θ / 2π) chords
+
+
+def arcs_area_and_bound(path: Path) -> tuple[float, float]:
+    """Exact area of the arcs file's plate (profile loop minus bore loop) by Green's theorem, and the bound
+    on what OpenSCAD's chords (≤ 2π/ARC_FN each) and 0.001 mm vertex grid may change it [mm²]."""
+    msp = ezdxf.readfile(path).modelspace()
+    areas, bound = {}, 0.0
+    delta = 2.0 * math.pi / ARC_FN
+    for layer in ("CAM_PROFILE", "BORE"):
+        entities = [e for e in msp if e.dxf.layer == layer]
+        if not entities:
+            continue
+        if [e.dxftype() for e in entities] == ["CIRCLE"]:
+            r = entities[0].dxf.radius
+            areas[layer], length = math.pi * r * r, 2.0 * math.pi * r
+            bound += r * r * math.pi * delta**2 / 6.0  # 2π r²Δ²/12: the segments a Δ-chord polygon cuts off
+        else:
+            areas[layer], length, segments = loop_area(entities, delta)
+            bound += segments
+        bound += DXF_GRID / math.sqrt(2) * length
+    return areas["CAM_PROFILE"] - areas.get("BORE", 0.0), bound
+
+
+def loop_area(entities, delta: float) -> tuple[float, float, float]:
+    """|½∮(x dy − y dx)| of a closed chain of ARC and LINE entities (closed forms), its length, and the
+    largest area the chords of sweep ≤ delta can cut off or add (Σ r² θ Δ² / 12)."""
+    pieces = []  # (start, end, contribution ½∫(x dy − y dx) in the entity's own direction, length, segments)
+    for e in entities:
+        if e.dxftype() == "LINE":
+            a, b = np.asarray(e.dxf.start)[:2], np.asarray(e.dxf.end)[:2]
+            pieces.append((a, b, 0.5 * (a[0] * b[1] - a[1] * b[0]), float(np.linalg.norm(b - a)), 0.0))
+            continue
+        c, r = np.asarray(e.dxf.center)[:2], e.dxf.radius
+        t0 = math.radians(e.dxf.start_angle)
+        sweep = math.radians(e.dxf.end_angle - e.dxf.start_angle) % (2.0 * math.pi)
+        t1 = t0 + sweep
+        a = c + r * np.array([math.cos(t0), math.sin(t0)])
+        b = c + r * np.array([math.cos(t1), math.sin(t1)])
+        green = 0.5 * (
+            r * r * sweep + r * (c[0] * (math.sin(t1) - math.sin(t0)) - c[1] * (math.cos(t1) - math.cos(t0)))
+        )
+        pieces.append((a, b, green, r * sweep, r * r * sweep * delta**2 / 12.0))
+    total, length, segments = 0.0, 0.0, 0.0
+    start, end, contribution, size, cut = pieces.pop(0)
+    total, length, segments, here = contribution, size, cut, end
+    while pieces:
+        k = int(np.argmin([min(np.linalg.norm(p[0] - here), np.linalg.norm(p[1] - here)) for p in pieces]))
+        a, b, contribution, size, cut = pieces.pop(k)
+        forward = np.linalg.norm(a - here) <= np.linalg.norm(b - here)
+        total += contribution if forward else -contribution
+        here = b if forward else a
+        length += size
+        segments += cut
+    assert np.linalg.norm(here - start) < 1e-6  # the chain closes
+    return abs(total), length, segments
+
+
+def test_linear_extrude_of_the_arcs_dxf_has_the_expected_volume(built: Built, tmp_path):
+    """profile_arcs.dxf: ARC and LINE entities, which OpenSCAD reads (it ignores SPLINE)."""
+    from camcad.export.dxf import write_profile_arcs_dxf
+
+    t = built.design.cam.thickness
+    dxf = write_profile_arcs_dxf(
+        tmp_path / "profile_arcs.dxf",
+        cam=built.cam, fit=built.fit, plate=built.design.plate(), options=built.design.dxf,
+    )  # fmt: skip
+    openscad(
+        f'linear_extrude(height = {t!r}) import("{dxf.name}", $fn = {ARC_FN});\n', tmp_path / "plate.stl"
+    )
+    mesh = trimesh.load(tmp_path / "plate.stl", force="mesh")
+    assert mesh.is_watertight
+    area, bound = arcs_area_and_bound(dxf)
+    assert mesh.volume == pytest.approx(area * t, abs=bound * t)
+    # and the arcs' plate is the solid's cross-section within the arcs' tolerance × the perimeter
+    perimeter = poly_dxf_perimeter(built.poly_dxf)
+    assert abs(area - built.solid.spline_area) <= 1.01 * built.fit.tolerance * perimeter + 1e-9
+
+
+def test_profile_dxf_gives_openscad_no_construction_outline(built: Built, tmp_path):
+    """OpenSCAD extrudes every closed contour it can read; in profile.dxf that must be at most the bore.
+
+    OpenSCAD ignores SPLINE (the profile) and drops open paths (the pitch-curve dashes,
+    centre lines); what is left is the bore, far smaller than the part, never the pitch
+    curve's 1.8× larger region.
+    """
+    t = built.design.cam.thickness
+    dxf = tmp_path / "profile.dxf"
+    dxf.write_bytes(built.dxf.read_bytes())
+    program = require("openscad")
+    scad = tmp_path / "plate.scad"
+    scad.write_text(f'linear_extrude(height = {t!r}) import("{dxf.name}");\n', encoding="utf-8")
+    result = run([program, "-o", str(tmp_path / "plate.stl"), str(scad)], cwd=tmp_path)
+    bore = built.design.plate().bore
+    if not (tmp_path / "plate.stl").is_file() or (tmp_path / "plate.stl").stat().st_size == 0:
+        assert bore is None, result.stderr[-3000:]  # nothing closed at all: OpenSCAD refuses an empty object
+        return
+    mesh = trimesh.load(tmp_path / "plate.stl", force="mesh")
+    assert bore is not None
+    assert abs(mesh.volume) <= bore.area * t * (1.0 + 1e-3)
