@@ -25,14 +25,27 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from camcad._plots import Plot, compare_plots, report_plots
+from camcad._plots.compare import compare_colors
 from camcad.export.records import write_text
 from camcad.findings import Finding
+from camcad.report_tables import (
+    fmt,
+    joint_rows,
+    label,
+    large_acceleration_jumps,
+    quantity_rows,
+    split_unit,
+)
 
 if TYPE_CHECKING:
     from camcad.analysis import Analysis
 
 __all__ = [
+    "CSS",
+    "alerts_html",
     "compare_table",
+    "compare_text",
+    "key_numbers_html",
     "render_compare",
     "render_report",
     "write_compare",
@@ -41,15 +54,16 @@ __all__ = [
 
 _DASH = "—"
 
-_CSS = """
+CSS = """
 :root { --ink:#1d2733; --muted:#5b6877; --line:#d8dee6; --bg:#f5f7fa; --card:#fff;
         --warn:#fff4d6; --warn-edge:#e0a800; --bad:#fde2e1; --bad-edge:#c0392b;
         --ok:#e3f4e8; --ok-edge:#2e8b57; }
 * { box-sizing: border-box; }
+html { -webkit-text-size-adjust: 100%; }
 body { margin:0; font: 14px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, sans-serif;
-       color:var(--ink); background:var(--bg); }
-main { max-width: 1280px; margin: 0 auto; padding: 20px 24px 40px; }
-header h1 { margin: 0 0 4px; font-size: 24px; }
+       color:var(--ink); background:var(--bg); overflow-wrap: anywhere; }
+main { max-width: 1400px; margin: 0 auto; padding: 20px clamp(10px, 3vw, 24px) 40px; }
+header h1 { margin: 0 0 4px; font-size: clamp(19px, 4vw, 24px); }
 header p { margin: 0; color: var(--muted); }
 h2 { font-size: 18px; margin: 28px 0 10px; border-bottom: 1px solid var(--line); padding-bottom: 4px; }
 h3 { font-size: 15px; margin: 18px 0 6px; }
@@ -60,28 +74,70 @@ h3 { font-size: 15px; margin: 18px 0 6px; }
 .warn { background: var(--warn); border-color: var(--warn-edge); }
 .bad { background: var(--bad); border-color: var(--bad-edge); }
 .ok { background: var(--ok); border-color: var(--ok-edge); }
-.cards { display: grid; grid-template-columns: repeat(auto-fill, minmax(190px, 1fr)); gap: 10px;
-         margin-top: 16px; }
-.card { background: var(--card); border: 1px solid var(--line); border-radius: 6px; padding: 10px 12px; }
+.glance { display: grid; grid-template-columns: minmax(0, 5fr) minmax(0, 6fr); gap: 14px; margin-top: 16px;
+          align-items: start; }
+.cards { display: grid; grid-template-columns: repeat(auto-fill, minmax(min(100%, 170px), 1fr)); gap: 10px; }
+.card { background: var(--card); border: 1px solid var(--line); border-radius: 6px; padding: 8px 11px; }
 .card.over { border-color: var(--bad-edge); background: var(--bad); }
 .card .label { color: var(--muted); font-size: 12px; text-transform: uppercase; letter-spacing: .03em; }
-.card .value { font-size: 21px; font-weight: 600; font-variant-numeric: tabular-nums; }
+.card .value { font-size: 20px; font-weight: 600; font-variant-numeric: tabular-nums; }
 .card .note { color: var(--muted); font-size: 12px; }
-.plots { display: grid; grid-template-columns: repeat(auto-fit, minmax(520px, 1fr)); gap: 14px; }
+.plots { display: grid; grid-template-columns: repeat(auto-fit, minmax(min(100%, 460px), 1fr)); gap: 14px; }
 figure { margin: 0; background: var(--card); border: 1px solid var(--line); border-radius: 6px;
-         padding: 10px; }
+         padding: 10px; min-width: 0; }
 figure img { width: 100%; height: auto; display: block; }
+figure.small img { max-width: 460px; margin: 0 auto; }
+figure.note { background: #f0f3f7; align-self: start; }
 figcaption { color: var(--muted); font-size: 12.5px; margin-top: 6px; }
 figcaption b { color: var(--ink); }
+.scroll { max-width: 100%; overflow-x: auto; }
 table { border-collapse: collapse; background: var(--card); margin: 4px 0 10px;
-        font-variant-numeric: tabular-nums; }
-th, td { border: 1px solid var(--line); padding: 4px 9px; text-align: left; vertical-align: top; }
+        font-variant-numeric: tabular-nums; max-width: 100%; }
+th, td { border: 1px solid var(--line); padding: 4px 8px; text-align: left; vertical-align: top; }
 th { background: #eef2f6; font-weight: 600; }
 td.num { text-align: right; white-space: nowrap; }
-td code, th code { font-size: 12.5px; }
-.tables { display: grid; grid-template-columns: repeat(auto-fit, minmax(420px, 1fr)); gap: 0 24px; }
-.wide { grid-column: 1 / -1; overflow-x: auto; }
+td table { margin: 0; }
+.tables { display: grid; grid-template-columns: repeat(auto-fit, minmax(min(100%, 400px), 1fr));
+          gap: 0 24px; }
+.tables > div { min-width: 0; }
+.wide { grid-column: 1 / -1; }
+.key { list-style: none; padding: 0; margin: 0 0 10px; display: flex; flex-wrap: wrap; gap: 4px 18px; }
+.key .swatch { display: inline-block; width: 22px; height: 0; border-top: 4px solid; vertical-align: middle;
+               margin-right: 6px; }
 footer { margin-top: 30px; color: var(--muted); font-size: 12px; }
+@media (max-width: 900px) {
+  .glance { grid-template-columns: minmax(0, 1fr); }
+}
+@media (max-width: 560px) {
+  body { font-size: 13px; }
+  th, td { padding: 3px 5px; }
+  .card .value { font-size: 18px; }
+}
+@page { size: auto; margin: 12mm 11mm; }
+@media print {
+  body { background: #fff; font-size: 9.5pt; }
+  main { max-width: none; padding: 0; }
+  h2 { margin: 12px 0 6px; font-size: 12pt; break-after: avoid; }
+  .alert { margin-top: 8px; padding: 6px 10px; }
+  .glance { grid-template-columns: minmax(0, 3fr) minmax(0, 2fr); gap: 8px; margin-top: 8px; }
+  .glance figure img { max-height: 118mm; width: auto; max-width: 100%; margin: 0 auto; }
+  .cards { grid-template-columns: repeat(2, minmax(0, 1fr)); gap: 5px; }
+  .card { padding: 4px 7px; }
+  .card .value { font-size: 12pt; }
+  .card .label, .card .note { font-size: 7.5pt; }
+  .plots { display: block; }
+  .plots figure { break-inside: avoid; margin: 0 0 6px; padding: 4px; }
+  .plots figure img { max-height: 96mm; width: auto; max-width: 100%; margin: 0 auto; }
+  figure { border-color: #ccc; }
+  .scroll { overflow: visible; }
+  .tables { display: block; column-count: 2; column-gap: 6mm; }
+  .tables > .wide { column-span: all; }
+  table { width: 100%; font-size: 8pt; }
+  th, td { padding: 2px 4px; }
+  figure.small img { max-height: 60mm; }
+  tr, figure, .card { break-inside: avoid; }
+  .tables > div { break-inside: avoid; }
+}
 """
 
 
@@ -119,11 +175,20 @@ def _peak(values: Any, fn: Callable[[np.ndarray], Any] = np.max) -> float | None
     return float(fn(arr)) if arr.size else None
 
 
-def _img(plot: Plot) -> str:
-    data = base64.b64encode(plot.png).decode("ascii")
+def _img(plot: Plot, *, cls: str = "") -> str:
+    """A figure: the image as a ``data:`` URI (SVG, or PNG), or just its caption for a note."""
+    klass = f' class="{cls}"' if cls else ""
+    if plot.svg is not None:
+        src = "data:image/svg+xml;base64," + base64.b64encode(plot.svg).decode("ascii")
+    elif plot.png is not None:
+        src = "data:image/png;base64," + base64.b64encode(plot.png).decode("ascii")
+    else:
+        return (
+            f'<figure id="plot-{_e(plot.key)}" class="note {cls}"><figcaption><b>{_e(plot.title)}.</b> '
+            f"{_e(plot.caption)}</figcaption></figure>"
+        )
     return (
-        f'<figure id="plot-{_e(plot.key)}"><img alt="{_e(plot.title)}" '
-        f'src="data:image/png;base64,{data}">'
+        f'<figure id="plot-{_e(plot.key)}"{klass}><img alt="{_e(plot.title)}" src="{src}">'
         f"<figcaption><b>{_e(plot.title)}.</b> {_e(plot.caption)}</figcaption></figure>"
     )
 
@@ -132,7 +197,7 @@ def _page(title: str, body: str) -> str:
     return (
         '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-        f"<title>{_e(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n<main>\n"
+        f"<title>{_e(title)}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<main>\n"
         f"{body}\n</main>\n</body>\n</html>\n"
     )
 
@@ -162,39 +227,6 @@ def _is_records(value: Any) -> bool:
     return isinstance(value, (list, tuple)) and bool(value) and all(isinstance(v, Mapping) for v in value)
 
 
-def _cell(value: Any) -> str:
-    """An escaped table cell for any summary value."""
-    if isinstance(value, Mapping):
-        return _mapping_table(value)
-    if _is_records(value):
-        return _records_table(value)
-    if isinstance(value, (list, tuple)):
-        return _e(", ".join(_cell_text(v) for v in value)) if value else _DASH
-    return _e(_cell_text(value))
-
-
-def _cell_text(value: Any) -> str:
-    if value is None or isinstance(value, (bool, int, float, np.integer, np.floating)):
-        return _num(value)
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_cell_text(v) for v in value) + "]"
-    return str(value)
-
-
-def _mapping_table(mapping: Mapping[str, Any], *, skip: Sequence[str] = ()) -> str:
-    rows = [[f"<code>{_e(k)}</code>", _cell(v)] for k, v in mapping.items() if k not in skip]
-    return _table(None, rows) if rows else f"<p>{_DASH}</p>"
-
-
-def _records_table(records: Sequence[Mapping[str, Any]]) -> str:
-    keys: list[str] = []
-    for rec in records:
-        keys += [k for k in rec if k not in keys]
-    header = [f"<code>{_e(k)}</code>" for k in keys]
-    rows = [[_cell(rec.get(k)) for k in keys] for rec in records]
-    return _table(header, rows)
-
-
 def _alert(kind: str, title: str, items: Sequence[str], *, anchor: str = "") -> str:
     """A highlighted box: ``kind`` is ``bad``, ``warn`` or ``ok``; ``items`` plain text."""
     ident = f' id="{_e(anchor)}"' if anchor else ""
@@ -210,12 +242,26 @@ def _finding_lines(findings: Sequence[Finding]) -> list[str]:
     return [f"{f.kind} ({f.severity.value} limit, {f.field}): {f.message}" for f in findings]
 
 
-def _alerts(analysis: Analysis) -> str:
-    """The banner: hard limits, then soft limits, then notes (see camcad.findings for the rule)."""
+def _jump_lines(analysis: Analysis, summary: Mapping[str, Any]) -> list[str]:
+    """Banner lines for large acceleration jumps at motion joints (see :mod:`camcad.report_tables`)."""
+    motion = summary.get("motion", {})
+    unit = analysis.cam.follower.kind.lift_unit
+    a_peak = motion.get(f"a_max_abs_{unit}_per_rad2")
+    return large_acceleration_jumps(
+        motion.get("joints", []),
+        unit=unit,
+        a_peak=a_peak,
+        mass_kg=analysis.design.dynamics.follower_mass,
+        speed_rpm=analysis.design.cam.speed_rpm,
+    )
+
+
+def _alerts(analysis: Analysis, summary: Mapping[str, Any]) -> str:
+    """The banner: hard limits, soft limits, then notes and large acceleration jumps (camcad.findings)."""
     hard = [f for f in analysis.findings if f.hard]
     soft = [f for f in analysis.findings if not f.hard]
     said = {f.message for f in analysis.findings}
-    notes = [w for w in analysis.warnings if w not in said]
+    notes = [w for w in analysis.warnings if w not in said] + _jump_lines(analysis, summary)
     out = []
     if hard:
         out.append(_alert("bad", "Hard limits broken", _finding_lines(hard), anchor="violations"))
@@ -224,7 +270,8 @@ def _alerts(analysis: Analysis) -> str:
             _alert("warn", f"Soft limits broken ({len(soft)})", _finding_lines(soft), anchor="warnings")
         )
     if notes:
-        out.append(_alert("warn", f"Notes ({len(notes)})", notes))
+        anchor = "" if soft else "warnings"
+        out.append(_alert("warn", f"Notes ({len(notes)})", notes, anchor=anchor))
     if not out:
         out.append(_alert("ok", "No warnings", ["Every checked limit is met."], anchor="warnings"))
     return "\n".join(out)
@@ -281,6 +328,8 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
     alpha_note = f"limit {k['alpha_limit']:.2f}°"
     if k["alpha_at"] is not None:
         alpha_note += f", at φ = {k['alpha_at']:.1f}°"
+    if abs(k["alpha"]) < 1e-9 and not cam.is_roller and cam.kinematics.guide.pivot is None:
+        alpha_note = "always 0°: the face is square to its slide"
     rho_note = (
         f"convex profile, at φ = {k['rho_at']:.1f}°"
         if k["rho_at"] is not None
@@ -301,7 +350,14 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
         fit_card = _card(
             "NURBS fit",
             f"{k['control_points']} control points",
-            f"max error {_num(k['fit_error'], '.3g')} mm (tolerance {_num(k['fit_tolerance'], 'g')} mm)",
+            f"max error {_num(1000.0 * k['fit_error'], '.3g')} µm "
+            f"(tolerance {_num(1000.0 * k['fit_tolerance'], 'g')} µm)",
+        )
+    gcode = analysis.gcode.summary() if analysis.gcode is not None else None
+    if gcode is not None:
+        minutes = float(gcode.get("cycle_time_s", 0.0)) / 60.0
+        gcode_card = _card(
+            "G-code", f"{gcode.get('blocks')} blocks", f"{gcode.get('arcs')} arcs, about {minutes:.1f} min"
         )
     cards = [
         _card("Arm swing", f"{k['lift']:.3f}°")
@@ -321,6 +377,7 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
         ),
         _card("Max Hertz stress", f"{_num(k['stress'], '.2f')} MPa", stress_note, over=stress_over),
         fit_card,
+        *([gcode_card] if gcode is not None else []),
     ]
     return '<section class="cards" id="key-numbers">' + "".join(cards) + "</section>"
 
@@ -349,7 +406,7 @@ def _design_table(analysis: Analysis) -> str:
     design, cam = analysis.design, analysis.cam
     spec = design.cam
     rows = [
-        ("follower", design.follower.kind.value),
+        ("follower type", design.follower.kind.value),
         ("base radius [mm]", _num(spec.base_radius)),
         ("follower", _e(cam.kinematics.describe())),
         ("roller radius [mm]", _num(cam.roller_radius) if cam.is_roller else _DASH),
@@ -363,23 +420,58 @@ def _design_table(analysis: Analysis) -> str:
     return _table(None, [[_e(a), _e(b)] for a, b in rows])
 
 
+def _quantities_table(section: Mapping[str, Any], *, skip: Sequence[str] = ()) -> str:
+    """A section of ``summary.json`` as quantity [unit] | value | where, nested sections below it."""
+    rows = [[_e(q), _e(v), _e(w)] for q, v, w in quantity_rows(section, skip=skip)]
+    out = [_table(["quantity", "value", "where"], rows)] if rows else []
+    for key, value in section.items():
+        if key in skip:
+            continue
+        if isinstance(value, Mapping):
+            out.append(f"<h4>{_e(label(key))}</h4>{_quantities_table(value, skip=('warnings',))}")
+        elif _is_records(value):
+            out.append(f"<h4>{_e(label(key))}</h4>{_records_table(value)}")
+    return "".join(out) or f"<p>{_DASH}</p>"
+
+
+def _records_table(records: Sequence[Mapping[str, Any]]) -> str:
+    keys: list[str] = []
+    for rec in records:
+        keys += [k for k in rec if k not in keys]
+    header = [_e(label(k)) for k in keys]
+    rows = [[_e(fmt(rec.get(k), split_unit(k)[1])) for k in keys] for rec in records]
+    return f'<div class="scroll">{_table(header, rows)}</div>'
+
+
+_SECTION_TITLES = {"gcode": "G-code", "fit": "NURBS fit", "second_plate": "Second plate"}
+_NOT_TABLES = ("camcad_version", "design", "warnings", "violations", "findings")
+
+
 def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
     out = ['<section class="tables" id="tables">']
     out.append(f"<div><h3>Design</h3>{_design_table(analysis)}</div>")
     out.append(f"<div><h3>Motion program</h3>{_program_table(analysis)}</div>")
-    motion = summary.get("motion", {})
-    out.append(f"<div><h3>Motion</h3>{_mapping_table(motion, skip=('joints',))}</div>")
-    for name in ("geometry", "dynamics", "fit", "gcode"):
-        section = summary.get(name)
-        if section is None:
+    for name, section in summary.items():
+        if name in _NOT_TABLES or not isinstance(section, Mapping):
             continue
-        title = {"gcode": "G-code"}.get(name, name.capitalize())
-        body = _mapping_table(section, skip=("warnings",)) if isinstance(section, Mapping) else _cell(section)
-        out.append(f'<div id="table-{name}"><h3>{_e(title)}</h3>{body}</div>')
+        title = _SECTION_TITLES.get(name, name.replace("_", " ").capitalize())
+        body = _quantities_table(section, skip=("warnings", "joints"))
+        out.append(f'<div id="table-{_e(name)}"><h3>{_e(title)}</h3>{body}</div>')
+    motion = summary.get("motion", {})
     joints = motion.get("joints")
     if joints:
+        unit = analysis.cam.follower.kind.lift_unit
+        header, rows = joint_rows(
+            joints,
+            unit=unit,
+            a_peak=motion.get(f"a_max_abs_{unit}_per_rad2"),
+            mass_kg=analysis.design.dynamics.follower_mass,
+            speed_rpm=analysis.design.cam.speed_rpm,
+        )
+        table = _table([_e(h) for h in header], [[_e(c) for c in row] for row in rows])
         out.append(
-            f'<div class="wide" id="table-joints"><h3>Motion joints</h3>{_records_table(joints)}</div>'
+            '<div class="wide" id="table-joints"><h3>Motion joints: what each jump means</h3>'
+            f'<div class="scroll">{table}</div></div>'
         )
     out.append("</section>")
     return "\n".join(out)
@@ -387,6 +479,39 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
 
 # ---------------------------------------------------------------------------
 # public API
+
+
+def _fea_section(analysis: Analysis) -> str:
+    """The finite-element check (issue 22): a table of its load cases and a stress picture per case."""
+    fea = getattr(analysis, "fea", None)
+    if fea is None:
+        return ""
+    from camcad.fea.plot import stress_figures
+
+    rows = [
+        [
+            _e(i),
+            _e(sc.case.label),
+            _e(_num(sc.case.angle_deg, ".2f")),
+            _e(_num(sc.case.force, ".2f")),
+            _e(_num(sc.case.peak_pressure, ".1f")),
+            _e(_num(sc.peak.value, ".1f")),
+            _e(sc.peak.where),
+        ]
+        for i, sc in enumerate(fea.cases, start=1)
+    ]
+    header = ["case", "load case", "φ [°]", "force [N]", "Hertz p0 [MPa]", "von Mises [MPa]", "where"]
+    limit = "no allowable set" if fea.allowable_stress is None else f"allowable {fea.allowable_stress:g} MPa"
+    figures = "".join(
+        _img(Plot(key=f"fea-{i}", title=title, caption=caption, png=png))
+        for i, (title, caption, png) in enumerate(stress_figures(fea), start=1)
+    )
+    return (
+        f'<h2 id="fea-heading">Finite-element check</h2>\n<section id="fea">'
+        f"<p>{_e(fea.plane.value.join(('Plane ', ' model')))}, {len(fea.nodes)} nodes, {len(fea.cells)} "
+        f"quadratic triangles; {_e(limit)}; fields in stress.vtu.</p>{_table(header, rows)}"
+        f'<section class="plots">{figures}</section></section>'
+    )
 
 
 def render_report(analysis: Analysis) -> str:
@@ -400,29 +525,56 @@ def render_report(analysis: Analysis) -> str:
     Returns
     -------
     str
-        A complete, self-contained HTML page: warnings, key numbers, figures
-        (motion, pressure angle, curvature, dynamics and the profile to scale,
-        as embedded PNG) and the tables of ``summary.json``. Pure: writes nothing.
+        A complete, self-contained HTML page: warnings, the cam drawing with
+        the key numbers beside it, the figures (motion, pressure angle,
+        curvature, dynamics, fit error, toolpath, solid; SVG embedded as
+        ``data:`` URIs) and the tables of ``summary.json`` in words with units.
+        Laid out for any width and for print (A4 or Letter: the drawing and
+        the key numbers on page 1). Pure and deterministic: writes nothing,
+        holds no time.
     """
     summary = analysis.summary()
     name = analysis.design.cam.name
     source = analysis.design.source
     version = summary.get("camcad_version", "")
-    sub = [f"source: {source}" if source else "", f"speed {analysis.design.cam.speed_rpm:g} rpm"]
+    sub = [
+        f"source: {source}" if source else "",
+        analysis.cam.kinematics.describe(),
+        f"speed {analysis.design.cam.speed_rpm:g} rpm",
+    ]
     header = f"<header><h1>{_e(name)}</h1><p>{_e(' · '.join(s for s in sub if s))}</p></header>"
-    plots = "".join(_img(p) for p in report_plots(analysis))
+    plots = report_plots(analysis)
+    drawing = next((p for p in plots if p.key == "profile"), None)
+    rest = "".join(_img(p, cls="small" if p.key == "solid" else "") for p in plots if p is not drawing)
+    glance = (
+        '<section class="glance" id="glance">'
+        + (_img(drawing) if drawing is not None else "")
+        + _cards(analysis, _key_numbers(analysis, summary))
+        + "</section>"
+    )
     body = "\n".join(
         [
             header,
-            _alerts(analysis),
-            _cards(analysis, _key_numbers(analysis, summary)),
-            f'<h2>Plots</h2>\n<section class="plots" id="plots">{plots}</section>',
+            _alerts(analysis, summary),
+            glance,
+            f'<h2 id="plots-heading">Plots</h2>\n<section class="plots" id="plots">{rest}</section>',
+            _fea_section(analysis),
             "<h2>Tables</h2>",
             _summary_tables(analysis, summary),
             f"<footer>camcad {_e(version)} · angles in degrees, lengths in mm</footer>",
         ]
     )
     return _page(f"camcad report: {name}", body)
+
+
+def key_numbers_html(analysis: Analysis) -> str:
+    """The report's key-number cards of one analysis, as an HTML fragment (the designer shows them live)."""
+    return _cards(analysis, _key_numbers(analysis, analysis.summary()))
+
+
+def alerts_html(analysis: Analysis) -> str:
+    """The report's warning banner of one analysis, as an HTML fragment."""
+    return _alerts(analysis, analysis.summary())
 
 
 def write_report(analysis: Analysis, path: str | Path) -> Path:
@@ -464,9 +616,54 @@ def compare_table(analyses: Sequence[Analysis]) -> list[list[str]]:
     """
     keys = [_key_numbers(a, a.summary()) for a in analyses]
     table = [["quantity", *_names(analyses)]]
-    for label, key, spec in _COMPARE_ROWS:
-        table.append([label, *(_num(k[key], spec) for k in keys)])
+    for text, key, spec in _COMPARE_ROWS:
+        table.append([text, *(_num(k[key], spec) for k in keys)])
     return table
+
+
+def _letter(i: int) -> str:
+    """Column tag of the i-th design: A to Z, then A2 to Z2, and so on."""
+    return chr(ord("A") + i % 26) + (str(i // 26 + 1) if i >= 26 else "")
+
+
+def compare_text(analyses: Sequence[Analysis], *, width: int = 100) -> str:
+    """:func:`compare_table` as terminal text no wider than ``width`` columns.
+
+    When the names do not fit side by side, the designs become columns A, B,
+    C, … named in a legend above the table (names cut with … to ``width``),
+    and when even the tagged columns do not fit they are split into blocks
+    of as many designs as fit. Control characters in names become spaces.
+    """
+    table = [[_terminal(c) for c in row] for row in compare_table(analyses)]
+
+    def render(rows: list[list[str]]) -> list[str]:
+        widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+        return [
+            "  ".join(c.rjust(w) if j else c.ljust(w) for j, (c, w) in enumerate(zip(r, widths, strict=True)))
+            .rstrip()
+            for r in rows
+        ]
+
+    plain = render(table)
+    if max(len(line) for line in plain) <= width:
+        return "\n".join(plain)
+    names = table[0][1:]
+    legend = [f"{_letter(i)} = {n}" for i, n in enumerate(names)]
+    legend = [line if len(line) <= width else line[: width - 1] + "…" for line in legend]
+    tagged = [[table[0][0], *(_letter(i) for i in range(len(names)))], *table[1:]]
+    first = max(len(r[0]) for r in tagged)
+    cell = max(len(c) for r in tagged for c in r[1:])
+    per_block = max(1, (width - first) // (cell + 2))
+    out = [*legend, ""]
+    for lo in range(0, len(names), per_block):
+        cols = [0, *range(1 + lo, 1 + min(lo + per_block, len(names)))]
+        out += [*render([[r[c] for c in cols] for r in tagged]), ""]
+    return "\n".join(out).rstrip("\n")
+
+
+def _terminal(text: str) -> str:
+    """One line of printable text: control characters (a newline in a cam name) become spaces."""
+    return " ".join("".join(c if c.isprintable() else " " for c in text).split())
 
 
 def render_compare(analyses: Sequence[Analysis]) -> str:
@@ -481,9 +678,9 @@ def render_compare(analyses: Sequence[Analysis]) -> str:
     -------
     str
         A self-contained page: the table of :func:`compare_table`, the
-        warnings of each design, and overlaid plots of s, v, a, pressure
-        angle, contact force and torque against the cam angle plus the
-        profiles to scale.
+        warnings of each design, and one figure per quantity (s, v, a,
+        pressure angle, contact force, torque against the cam angle, one line
+        per design) plus the profiles to scale, each sized for its column.
     """
     if not analyses:
         raise ValueError("render_compare needs at least one analysis")
@@ -495,18 +692,25 @@ def render_compare(analyses: Sequence[Analysis]) -> str:
     for name, analysis in zip(names, analyses, strict=True):
         said = {f.message for f in analysis.findings}
         findings = [*_finding_lines(analysis.findings), *(w for w in analysis.warnings if w not in said)]
+        findings += _jump_lines(analysis, analysis.summary())
         if findings:
             alerts.append(_alert("bad" if analysis.violations else "warn", name, findings))
     if not alerts:
         alerts.append(_alert("ok", "No warnings", ["Every design meets its checked limits."]))
     plots = "".join(_img(p) for p in compare_plots(analyses, names))
+    key = "".join(
+        f'<li><span class="swatch" style="border-top-color:{color}"></span>{_e(name)}</li>'
+        for name, color in zip(names, compare_colors(len(names)), strict=True)
+    )
     body = "\n".join(
         [
             f"<header><h1>Comparison of {len(analyses)} cam designs</h1>"
             f"<p>{_e(' · '.join(names))}</p></header>",
             *alerts,
-            f'<h2>Side by side</h2><section class="wide" id="compare-table">{_table(header, rows)}</section>',
-            f'<h2>Plots</h2>\n<section class="plots" id="plots">{plots}</section>',
+            '<h2>Side by side</h2><section id="compare-table"><div class="scroll">'
+            f"{_table(header, rows)}</div></section>",
+            f'<h2 id="plots-heading">Plots</h2>\n<ul class="key" id="key">{key}</ul>'
+            f'\n<section class="plots" id="plots">{plots}</section>',
             "<footer>camcad · angles in degrees, lengths in mm</footer>",
         ]
     )

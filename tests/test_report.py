@@ -6,16 +6,24 @@ import sys
 from dataclasses import replace
 from html.parser import HTMLParser
 from pathlib import Path
+from xml.etree import ElementTree
 
 import pytest
 
 from camcad.design import load_design
 from camcad.pipeline import analyse, build
-from camcad.report import compare_table, render_compare, render_report, write_compare, write_report
+from camcad.report import (
+    compare_table,
+    render_compare,
+    render_report,
+    write_compare,
+    write_report,
+)
+from camcad.report_tables import fmt, label, quantity_rows, split_unit
 
 SAMPLES = Path(__file__).resolve().parents[1] / "samples"
-PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
-N_REPORT_PLOTS = 5  # profile, motion, pressure angle, curvature, dynamics
+N_REPORT_PLOTS = 7  # profile, motion, pressure angle, curvature, dynamics, fit error, solid (no toolpath)
+SVG_NS = "{http://www.w3.org/2000/svg}"
 
 
 class _Page(HTMLParser):
@@ -59,12 +67,23 @@ def parse(page: str) -> _Page:
     return parser
 
 
-def assert_png(src: str | None) -> None:
-    prefix = "data:image/png;base64,"
+def assert_svg(src: str | None) -> bytes:
+    """An embedded SVG that an XML parser reads, with drawn paths and text kept as text."""
+    prefix = "data:image/svg+xml;base64,"
     assert src is not None and src.startswith(prefix)
     data = base64.b64decode(src[len(prefix) :], validate=True)
-    assert data.startswith(PNG_SIGNATURE)
-    assert len(data) > 10_000  # a real plot, not an empty canvas
+    root = ElementTree.fromstring(data)
+    assert root.tag == f"{SVG_NS}svg"
+    assert len(root.findall(f".//{SVG_NS}path")) > 10  # a real plot, not an empty canvas
+    return data
+
+
+def test_figure_labels_are_text(page):
+    """Axis labels stay text in the SVG (crisp in print, found by pdftotext), with a generic font fallback."""
+    src = next(i["src"] for i in parse(page).images if i["alt"] == "Cam profile (to scale)")
+    root = ElementTree.fromstring(assert_svg(src))
+    texts = ["".join(t.itertext()) for t in root.iter(f"{SVG_NS}text")]
+    assert "x [mm]" in texts and "y [mm]" in texts
 
 
 def assert_offline(page: str) -> None:
@@ -98,7 +117,7 @@ def test_report_parses_with_name_and_plots(analysis, page):
     assert analysis.design.cam.name in parsed.plain
     assert len(parsed.images) == N_REPORT_PLOTS
     for image in parsed.images:
-        assert_png(image["src"])
+        assert_svg(image["src"])
         assert image["alt"]
 
 
@@ -120,18 +139,56 @@ def test_report_shows_key_numbers(analysis, page):
     assert f"{summary['dynamics']['contact_force_max_N']:.3f} N" in text
     assert f"{summary['dynamics']['hertz_stress_max_MPa']:.2f} MPa" in text
     assert f"{summary['fit']['control_points']} control points" in text
-    assert "No warnings" in text
+    assert "limits broken" not in text  # the sample meets every limit; its notes are the joints' jumps
 
 
-def test_report_tables_cover_every_summary_section(analysis, page):
+def test_report_tables_show_every_summary_number_in_words(analysis, page):
+    """Every number of summary.json is in the tables under a human label with its unit; no raw keys."""
     text = parse(page).plain
     summary = analysis.summary()
     for section in ("motion", "geometry", "dynamics", "fit"):
-        for key in summary[section]:
-            if key not in {"warnings", "joints"}:
-                assert key in text, f"{section}.{key} missing from the tables"
+        for key, value in summary[section].items():
+            if key in {"warnings", "joints"} or key.endswith(("_angle_deg", "_side")):
+                continue
+            assert label(key) in text or label(key).replace("[mm]", "[µm]") in text, key
+            assert "_" not in key or key not in text, f"raw key {key} shown"
+            if isinstance(value, float) and abs(value) >= 0.01:
+                assert fmt(value, split_unit(key)[1]) in text, (key, value)
+    assert "max |a| [mm/rad²]" in text and "a_max_abs" not in text
     for joint in summary["motion"]["joints"]:
-        assert joint["text"] in text
+        assert f"{joint['angle_deg']:.2f}" in text
+
+
+def test_labels_and_precision():
+    """Labels carry units; numbers have 4 significant digits, angles 0.01°, tiny lengths in µm."""
+    assert label("a_max_abs_mm_per_rad2") == "max |a| [mm/rad²]"
+    assert label("torque_max_Nmm") == "max input torque [N·mm]"
+    assert label("something_new_MPa") == "something new [MPa]"
+    assert fmt(0.000794357) == "0.0007944" and fmt(151.419) == "151.4" and fmt(13.53477, "°") == "13.53"
+    section = {"max_error_mm": 0.000794357, "torque_max_Nmm": 151.4}
+    section |= {"torque_max_angle_deg": 123.03, "torque_max_side": "after joint"}
+    rows = quantity_rows(section)
+    assert rows == [("certified max error [µm]", "0.7944", ""),
+                    ("max input torque [N·mm]", "151.4", "at 123.0° (just after joint)")]  # fmt: skip
+
+
+def test_acceleration_jumps_reach_the_banner_with_the_force_step():
+    """Harmonic rise into a dwell: a(β⁻) = −π²h/(2β²) (Norton 2009, §8.3), a jump the banner states in N.
+
+    The force step is m·Δa·ω² by hand from the design's mass and speed.
+    """
+    design = load_design(SAMPLES / "quintero_harmonic.toml")
+    rise, dwell = design.motion[0], design.motion[1]
+    assert rise.kind.value == "rise" and dwell.kind.value == "dwell"
+    da = math.pi**2 * rise.lift / (2.0 * rise.span**2)  # mm/rad², from −π²h/(2β²) to 0
+    omega = 2.0 * math.pi * design.cam.speed_rpm / 60.0
+    step = design.dynamics.follower_mass * da * 1e-3 * omega**2  # N
+    page = parse(render_report(analyse(design, fit=False, toolpath=False))).plain
+    banner = page[: page.index("Plots")]
+    at = f"φ = {math.degrees(rise.span):.1f}°"
+    assert f"acceleration jumps by {float(f'{da:.3g}'):g} mm/rad² at {at}" in banner
+    assert f"steps by {float(f'{step:.3g}'):g} N at {design.cam.speed_rpm:g} rpm" in banner
+    assert "what it means for the machine" in page
 
 
 def test_report_lists_every_warning_escaped(warned):
@@ -147,7 +204,7 @@ def test_report_lists_every_warning_escaped(warned):
     # the warnings come before the plots
     assert page.index('id="warnings"') < page.index('id="plots"')
     assert "not run" in parsed.plain  # no fit
-    assert len(parsed.images) == N_REPORT_PLOTS
+    assert len(parsed.images) == N_REPORT_PLOTS - 1  # no fit, no fit-error figure
 
 
 def test_render_is_deterministic(analysis, page):
@@ -204,7 +261,7 @@ def test_render_compare(quintero, tmp_path):
         assert " ".join(row) in " ".join(parsed.plain.split())
     assert parsed.images
     for image in parsed.images:
-        assert_png(image["src"])
+        assert_svg(image["src"])
     out = write_compare(analyses, tmp_path / "compare.html")
     assert out.read_text(encoding="utf-8") == page
 
@@ -238,8 +295,8 @@ def test_report_shows_the_programs_figures(analysis, tmp_path):
     assert blocks > 100 and arcs > 50  # a real program, not an empty one
     page = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert 'id="table-gcode"' in page
-    plain = parse(page).plain
-    section = plain[plain.index("G-code") :]
-    assert f"blocks {blocks} " in section and f"arcs {arcs} " in section
+    table = page[page.index('id="table-gcode"') :]
+    section = parse(table[table.index("<table>") : table.index("</table>") + 8]).plain
+    assert f"blocks {blocks} " in section and f"arc moves {arcs} " in section
     for key in ("cutting_length_mm", "cycle_time_s", "max_deviation_mm"):
-        assert key in section
+        assert label(key) in section or label(key).replace("[mm]", "[µm]") in section

@@ -1,0 +1,37 @@
+"""The live designer: ``camcad serve DESIGN.toml`` edits a design in the browser.
+
+A local web page shows the design's fields as a form (grouped as in the TOML,
+with the schema's units and ranges) and redraws the cam with its follower,
+the motion curves, pressure angle, curvature and dynamics, the key numbers
+and the warnings on every change (analysis without fit and toolpath). It
+saves the TOML and downloads the shop files as a zip. Stack: the standard
+library's HTTP server and one page of plain JavaScript drawing SVG (no web
+framework, no CDN, nothing to install beyond camcad). Modules: ``form``
+(fields from the schema, values back to a design mapping, TOML text),
+``payload`` (the JSON the page draws), ``page`` (HTML, CSS, script),
+``app`` (the server).
+"""
+
+from __future__ import annotations
+
+import webbrowser
+from pathlib import Path
+
+from camcad.serve.app import Designer, make_server
+
+__all__ = ["Designer", "make_server", "serve"]
+
+
+def serve(path: str | Path, *, port: int = 0, open_browser: bool = False) -> None:
+    """Serve the designer for ``path`` on 127.0.0.1 until interrupted (Ctrl-C).
+
+    ``port`` 0 takes a free port; ``open_browser`` opens the page in the default browser.
+    """
+    server, url = make_server(path, port=port)
+    print(f"camcad designer for {path} at {url}  (Ctrl-C to stop)", flush=True)
+    if open_browser:
+        webbrowser.open(url)
+    try:
+        server.serve_forever()
+    finally:
+        server.server_close()

@@ -1,0 +1,147 @@
+"""What the designer's page draws after each change: numbers, warnings, the drawing and the curves.
+
+:func:`evaluate` validates a design mapping with the loader, runs the
+analysis without fit and toolpath (motion, geometry, dynamics: tens of
+milliseconds) and returns plain JSON data: the report's key-number cards
+and warning banner (the same HTML fragments as ``report.html``), the cam
+drawing (profile, reference trace, base circle, bore, the follower at four
+angles, all in mm in the cam frame) and the curves against the cam angle,
+thinned to at most :data:`CURVE_POINTS` points (the extremes shown in the
+cards are camcad's true extremes, not those of the thinned curves). An
+invalid design gives the loader's message with the field it names.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from camcad._plots._base import trace_name
+from camcad._plots.design import CURVATURE_CLIP, bore_outline, follower_drawings
+from camcad.design import parse_design
+from camcad.errors import CamcadError, DesignError
+from camcad.pipeline import analyse
+from camcad.report import alerts_html, key_numbers_html
+
+if TYPE_CHECKING:
+    from camcad.analysis import Analysis
+
+__all__ = ["CURVE_POINTS", "evaluate"]
+
+CURVE_POINTS = 721
+"""Points per curve sent to the page (every 0.5° on the default grid)."""
+
+_OUTLINE_POINTS = 1441
+
+
+def _xy(points: Any, n: int = _OUTLINE_POINTS) -> list[list[float]]:
+    arr = np.asarray(points, dtype=float)
+    if len(arr) > n:
+        arr = arr[np.unique(np.linspace(0, len(arr) - 1, n).round().astype(int))]
+    return np.round(arr, 4).tolist()
+
+
+def _series(values: Any, index: np.ndarray, clip: float | None = None) -> list[float | None]:
+    arr = np.asarray(values, dtype=float)[index]
+    keep = np.isfinite(arr) if clip is None else np.isfinite(arr) & (np.abs(arr) <= clip)
+    return [round(float(v), 6) if k else None for v, k in zip(arr, keep, strict=True)]
+
+
+def _drawing(analysis: Analysis) -> dict[str, Any]:
+    cam, geo, spec = analysis.cam, analysis.geometry, analysis.design.cam
+    profile = np.asarray(geo.profile.point)
+    pitch = np.asarray(geo.pitch.point)
+    reach = float(max(np.hypot(*pitch.T).max() + cam.roller_radius, np.hypot(*profile.T).max()))
+    followers = []
+    for d in follower_drawings(analysis, reach):
+        followers.append(
+            {
+                "phi_deg": d.phi_deg,
+                "body": [_xy(p) for p in d.body],
+                "links": [_xy(p) for p in d.links],
+                "axes": [_xy(p) for p in d.axes],
+                "marks": _xy(d.marks),
+                "label_at": np.round(d.label_at, 4).tolist(),
+            }
+        )
+    return {
+        "profile": _xy(profile),
+        "trace": _xy(pitch),
+        "base_radius": cam.base_radius,
+        "bore": _xy(bore_outline(spec.bore, spec.keyway_width, spec.keyway_depth)) if spec.bore > 0.0 else [],
+        "followers": followers,
+        "rotation": cam.rotation.value,
+        "caption": f"To scale, cam frame at φ = 0, turning {cam.rotation.value}: the profile (filled), the "
+        f"{trace_name(analysis)} (dashed), the base circle r = {cam.base_radius:g} mm (dotted) and "
+        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°.",
+        "profile_radius_max": float(np.hypot(*profile.T).max()),
+    }
+
+
+def _chart(
+    key: str, title: str, unit: str, series: list[dict[str, Any]], limits: list[float]
+) -> dict[str, Any]:
+    return {"key": key, "title": title, "unit": unit, "series": series, "limits": limits}
+
+
+def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]]]:
+    """The cam angles [°] of the thinned grid and the charts drawn over them."""
+    geo, m, dyn, cam = analysis.geometry, analysis.motion, analysis.dynamics, analysis.cam
+    spec = analysis.design.dynamics
+    phi = np.asarray(geo.phi)
+    index = np.unique(np.linspace(0, len(phi) - 1, min(CURVE_POINTS, len(phi))).round().astype(int))
+    arm = cam.follower.kind.oscillating
+    u = "°" if arm else "mm"
+    x = "ψ" if arm else "s"
+    limit = math.degrees(geo.max_pressure_angle)
+    clip = CURVATURE_CLIP * cam.base_radius
+
+    def one(label: str, values: Any, bound: float | None = None) -> list[dict[str, Any]]:
+        return [{"label": label, "y": _series(values, index, bound)}]
+
+    rho = one("cam profile", geo.profile.rho, clip)
+    if cam.is_roller:
+        rho = one("roller-centre path", geo.pitch.rho, clip) + rho
+    roller = [cam.roller_radius] if cam.is_roller else []
+    stress_limits = [] if spec.allowable_stress is None else [spec.allowable_stress]
+    charts = [
+        _chart("s", "Arm angle ψ" if arm else "Displacement s", u, one("s", m.s), []),
+        _chart("v", "Velocity d" + x + "/dφ", f"{u}/rad", one("v", m.v), []),
+        _chart("a", "Acceleration d²" + x + "/dφ²", f"{u}/rad²", one("a", m.a), []),
+        _chart("j", "Jerk d³" + x + "/dφ³", f"{u}/rad³", one("j", m.j), []),
+        _chart(
+            "pressure", "Pressure angle α", "°", one("α", np.degrees(geo.pressure_angle)), [limit, -limit]
+        ),
+        _chart("curvature", "Radius of curvature ρ (clipped)", "mm", rho, roller),
+        _chart("force", "Contact force", "N", one("F", dyn.contact_force), [spec.min_contact_force]),
+        _chart("torque", "Input torque", "N·mm", one("T", dyn.torque), []),
+        _chart("stress", "Hertz stress", "MPa", one("σ", dyn.hertz_stress), stress_limits),
+    ]
+    return _series(np.degrees(phi), index), charts
+
+
+def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
+    """Validate and analyse a design mapping; the page's JSON (``ok`` False with ``errors`` when invalid)."""
+    try:
+        design = parse_design(data, source=source)
+        analysis = analyse(design, fit=False, toolpath=False, strict=False)
+    except DesignError as err:
+        return {"ok": False, "errors": [{"field": err.path, "message": err.message}]}
+    except CamcadError as err:  # a limit the analysis cannot get past even when not strict
+        return {"ok": False, "errors": [{"field": getattr(err, "field", ""), "message": str(err)}]}
+    summary = analysis.summary()
+    phi_deg, charts = _curves(analysis)
+    return {
+        "ok": True,
+        "errors": [],
+        "cards": key_numbers_html(analysis),
+        "alerts": alerts_html(analysis),
+        "drawing": _drawing(analysis),
+        "phi_deg": phi_deg,
+        "charts": charts,
+        "summary": {k: summary[k] for k in ("motion", "geometry", "dynamics") if k in summary},
+        "findings": [f.summary() for f in analysis.findings],
+    }

@@ -1,0 +1,102 @@
+"""The report and the compare page in a real browser: headless Chromium at three widths and in print.
+
+Checked against the browser's own layout: no horizontal scroll from 400 to
+1600 px (``scrollWidth ≤ clientWidth``), every image decoded
+(``naturalWidth > 0``), no table wider than its page; printed to PDF on A4
+and Letter (Chrome DevTools ``Page.printToPDF``) the page count is small and
+``pdftotext`` finds the cam drawing's caption and the key numbers on page 1.
+"""
+
+from __future__ import annotations
+
+import base64
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from camcad.design import load_design
+from camcad.pipeline import analyse
+from camcad.report import write_compare, write_report
+from tests.readers.browser import chromium
+
+pytestmark = pytest.mark.slow
+
+SAMPLES = Path(__file__).resolve().parents[2] / "samples"
+WIDTHS = (400, 500, 800, 1024, 1400, 1600)  # the issue's widths and the brief's
+PAPERS = {"A4": (8.27, 11.69), "Letter": (8.5, 11.0)}
+MAX_PAGES = 8
+
+_LAYOUT = """
+const root = document.scrollingElement;
+const images = [...document.images];
+const tables = [...document.querySelectorAll('table')].filter(t => !t.parentElement.closest('table'));
+return {
+  scroll: root.scrollWidth, client: root.clientWidth,
+  images: images.length, broken: images.filter(i => !(i.complete && i.naturalWidth > 0)).length,
+  overflowing: tables.filter(t => t.getBoundingClientRect().right > root.clientWidth + 1
+                                   && !t.closest('.scroll')).length,
+};
+"""
+
+
+@pytest.fixture(scope="module")
+def pages(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("pages")
+    out = {"report": write_report(analyse(load_design(SAMPLES / "quintero_vap_b01.toml")), folder / "r.html")}
+    for name, stem in (("tappet", "hren_tappet"), ("rocker", "rocker_flat")):  # flat faces: slide and arm
+        out[name] = write_report(
+            analyse(load_design(SAMPLES / f"{stem}.toml"), toolpath=False), folder / f"{name}.html"
+        )
+    paths = sorted(SAMPLES.glob("quintero_*"))
+    analyses = [analyse(load_design(p), fit=False, toolpath=False) for p in paths]
+    out["compare"] = write_compare(analyses, folder / "compare.html")
+    return out
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with chromium() as driver:
+        yield driver
+
+
+@pytest.mark.parametrize("name", ["report", "tappet", "rocker", "compare"])
+@pytest.mark.parametrize("width", WIDTHS)
+def test_no_horizontal_scroll_and_every_image_loads(browser, pages, name, width):
+    browser.set_window_size(width, 900)
+    browser.get(pages[name].as_uri())
+    layout = browser.execute_script(_LAYOUT)
+    assert layout["scroll"] <= layout["client"], f"{name} scrolls sideways at {width} px: {layout}"
+    assert layout["images"] >= 6 and layout["broken"] == 0, layout
+    assert layout["overflowing"] == 0, layout
+
+
+def _pdf(browser, path: Path, paper: tuple[float, float]) -> bytes:
+    browser.get(path.as_uri())
+    width, height = paper
+    out = browser.execute_cdp_cmd(
+        "Page.printToPDF", {"paperWidth": width, "paperHeight": height, "printBackground": True}
+    )
+    return base64.b64decode(out["data"])
+
+
+@pytest.mark.parametrize("paper", sorted(PAPERS))
+def test_print_is_short_with_drawing_and_key_numbers_on_page_one(browser, pages, paper, tmp_path):
+    if shutil.which("pdftotext") is None or shutil.which("pdfinfo") is None:
+        pytest.skip("pdftotext/pdfinfo not installed (apt-get install poppler-utils)")
+    pdf = tmp_path / "report.pdf"
+    pdf.write_bytes(_pdf(browser, pages["report"], PAPERS[paper]))
+    info = subprocess.run(["pdfinfo", str(pdf)], capture_output=True, text=True, check=True).stdout
+    count = int(next(line.split()[-1] for line in info.splitlines() if line.startswith("Pages:")))
+    assert 2 <= count <= MAX_PAGES, f"{count} pages on {paper}"
+    first = subprocess.run(
+        ["pdftotext", "-f", "1", "-l", "1", str(pdf), "-"], capture_output=True, text=True, check=True
+    ).stdout
+    flat = " ".join(first.split())
+    assert "Cam profile (to scale)" in flat  # the drawing's caption
+    for label in ("MAX PRESSURE ANGLE", "BASE RADIUS", "MAX CONTACT FORCE", "NURBS FIT", "13.53°"):
+        assert label in flat, f"{label} not on page 1 ({paper})"
+    # the tables are not clipped: the joint table's last column (the meaning) is printed in full
+    text = subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+    assert "what it means for the machine" in " ".join(text.split())
