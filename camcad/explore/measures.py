@@ -1,0 +1,220 @@
+r"""What a design is judged by: objectives, limits, and one table row per analysed design.
+
+The measures are true extremes from the analysis (``summary.json``'s
+figures, see :mod:`camcad.extremes`), in the units of the report:
+
+========================  ====  =================================================
+name                      unit  figure
+========================  ====  =================================================
+``base_radius``           mm    ``cam.base_radius`` (the cam's size)
+``pressure_angle``        deg   peak \|α\| over the turn
+``contact_stress``        MPa   peak Hertz stress
+``torque``                N·mm  peak \|input torque\|
+``contact_force``         N     peak contact force
+``contact_force_min``     N     smallest contact force (follower jump below 0)
+``curvature_radius``      mm    smallest convex profile radius
+========================  ====  =================================================
+
+A limit is ``name<=value`` or ``name>=value`` in those units (``--limit
+contact_stress<=800``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import operator
+import re
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from camcad.analysis import Analysis
+from camcad.errors import CamcadError, DesignError, UsageError
+
+__all__ = [
+    "MEASURES",
+    "Limit",
+    "Measure",
+    "analysis_row",
+    "failed_row",
+    "measure",
+    "measure_values",
+    "parse_limit",
+]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Measure:
+    """One figure a design is judged by: its name, unit, column and what it is."""
+
+    name: str
+    unit: str
+    column: str  # the row's column, e.g. "pressure_angle_deg"
+    text: str
+
+    def of(self, row: Mapping[str, Any]) -> float | None:
+        """The measure's value in a table row (None for a design that was not analysed)."""
+        value = row.get(self.column)
+        return None if value is None else float(value)
+
+
+def _torque(summary: Mapping[str, Any]) -> float | None:
+    dyn = summary["dynamics"]
+    values = [abs(v) for v in (dyn.get("torque_max_Nmm"), dyn.get("torque_min_Nmm")) if v is not None]
+    return max(values) if values else None
+
+
+_FIGURES: dict[str, Callable[[Analysis, Mapping[str, Any]], float | None]] = {
+    "base_radius": lambda a, s: a.design.cam.base_radius,
+    "pressure_angle": lambda a, s: s["geometry"]["pressure_angle_max_deg"],
+    "contact_stress": lambda a, s: s["dynamics"].get("hertz_stress_max_MPa"),
+    "torque": lambda a, s: _torque(s),
+    "contact_force": lambda a, s: s["dynamics"].get("contact_force_max_N"),
+    "contact_force_min": lambda a, s: s["dynamics"].get("contact_force_min_N"),
+    "curvature_radius": lambda a, s: s["geometry"]["curvature_radius_min_mm"],
+}
+
+MEASURES: dict[str, Measure] = {
+    m.name: m
+    for m in (
+        Measure(name="base_radius", unit="mm", column="base_radius_mm", text="base radius (cam size)"),
+        Measure(name="pressure_angle", unit="deg", column="pressure_angle_deg", text="peak |pressure angle|"),
+        Measure(name="contact_stress", unit="MPa", column="contact_stress_MPa", text="peak Hertz stress"),
+        Measure(name="torque", unit="N·mm", column="torque_Nmm", text="peak |input torque|"),
+        Measure(name="contact_force", unit="N", column="contact_force_N", text="peak contact force"),
+        Measure(
+            name="contact_force_min", unit="N", column="contact_force_min_N", text="smallest contact force"
+        ),
+        Measure(
+            name="curvature_radius",
+            unit="mm",
+            column="curvature_radius_mm",
+            text="smallest convex profile radius",
+        ),
+    )
+}
+"""The objectives and limit quantities by name."""
+
+
+def measure(name: str, flag: str) -> Measure:
+    """The measure called ``name`` or a UsageError naming ``flag`` and listing them."""
+    if name not in MEASURES:
+        raise UsageError(flag, f"unknown quantity {name!r} (allowed: {', '.join(MEASURES)})")
+    return MEASURES[name]
+
+
+_OPS: dict[str, Callable[[float, float], bool]] = {"<=": operator.le, ">=": operator.ge}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Limit:
+    """``measure op value``: a constraint on a measure (value in the measure's unit)."""
+
+    measure: Measure
+    op: str  # "<=" or ">="
+    value: float
+
+    @property
+    def text(self) -> str:
+        """``contact_stress<=800``."""
+        return f"{self.measure.name}{self.op}{self.value:g}"
+
+    def margin(self, value: float | None) -> float:
+        """How far ``value`` is inside the limit (≥ 0 holds), in the measure's unit; −inf when unknown."""
+        if value is None or not math.isfinite(value):
+            return -math.inf
+        return self.value - value if self.op == "<=" else value - self.value
+
+    def holds(self, row: Mapping[str, Any]) -> bool:
+        """The limit holds for a table row (False for a design that was not analysed)."""
+        return self.margin(self.measure.of(row)) >= 0.0
+
+
+def parse_limit(text: str, *, flag: str = "--limit") -> Limit:
+    """Read ``name<=value`` or ``name>=value``.
+
+    Raises
+    ------
+    UsageError
+        Naming ``flag`` and the text when the form, the name or the number is wrong.
+    """
+    match = re.fullmatch(r"\s*([a-z_]+)\s*(<=|>=)\s*([^\s]+)\s*", text)
+    if match is None:
+        raise UsageError(
+            flag, f"{text!r}: write quantity<=value or quantity>=value, e.g. contact_stress<=800"
+        )
+    try:
+        value = float(match[3])
+    except ValueError:
+        raise UsageError(flag, f"{text!r}: {match[3]!r} is not a number") from None
+    if not math.isfinite(value):
+        raise UsageError(flag, f"{text!r}: the limit must be a finite number")
+    return Limit(measure=measure(match[1], flag), op=match[2], value=value)
+
+
+def measure_values(analysis: Analysis, summary: Mapping[str, Any] | None = None) -> dict[str, float | None]:
+    """Every measure of an analysed design, by column name."""
+    s = analysis.summary() if summary is None else summary
+    out: dict[str, float | None] = {}
+    for name, m in MEASURES.items():
+        value = _FIGURES[name](analysis, s)
+        out[m.column] = None if value is None else float(value)
+    return out
+
+
+def _flat(prefix: str, section: Mapping[str, Any], out: dict[str, Any]) -> None:
+    """Scalars of a summary section as ``prefix.key``; lists as JSON text; warnings and joints left out."""
+    for key, value in section.items():
+        if key in ("warnings", "joints"):
+            continue
+        name = f"{prefix}.{key}"
+        if isinstance(value, Mapping):
+            _flat(name, value, out)
+        elif isinstance(value, (list, tuple)):
+            out[name] = json.dumps(value, separators=(",", ":"))
+        elif isinstance(value, bool) or value is None or isinstance(value, str):
+            out[name] = value
+        else:
+            out[name] = float(value)
+
+
+def analysis_row(analysis: Analysis, limits: Sequence[Limit]) -> dict[str, Any]:
+    """The verdicts, measures and every summary figure of one analysed design.
+
+    Columns: ``status`` (``ok`` no limit broken, ``limit`` a hard or soft
+    limit of the design broken), ``feasible`` (status ok and every
+    ``limits`` holds), ``violations`` (the broken limits' kinds, ``;``
+    separated), ``reason`` (the first broken limit's message), one
+    ``limit:<text>`` column per extra limit, the measures
+    (:data:`MEASURES`), then ``motion.*``, ``geometry.*``, ``dynamics.*``
+    from ``summary.json``.
+    """
+    summary = analysis.summary()
+    findings = analysis.findings
+    row: dict[str, Any] = {
+        "status": "limit" if findings else "ok",
+        "feasible": False,
+        "violations": "; ".join(dict.fromkeys(f.kind for f in findings)),
+        "reason": findings[0].message if findings else None,
+    }
+    values = measure_values(analysis, summary)
+    verdicts = {f"limit:{lim.text}": lim.holds(values) for lim in limits}
+    row.update(verdicts)
+    row["feasible"] = not findings and all(verdicts.values())
+    row.update(values)
+    for section in ("motion", "geometry", "dynamics"):
+        _flat(section, summary[section], row)
+    return row
+
+
+def failed_row(err: CamcadError, limits: Sequence[Limit]) -> dict[str, Any]:
+    """The row of a design that could not be analysed: ``invalid`` with the error as the reason."""
+    row: dict[str, Any] = {
+        "status": "invalid" if isinstance(err, DesignError) else "limit",
+        "feasible": False,
+        "violations": "invalid" if isinstance(err, DesignError) else type(err).__name__,
+        "reason": str(err),
+    }
+    row.update({f"limit:{lim.text}": False for lim in limits})
+    return row
