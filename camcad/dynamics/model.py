@@ -166,10 +166,10 @@ def _model(setup: DynamicsSetup) -> _Model:
     def evaluate(motion: Motion, alpha: FloatArray, rho: FloatArray, lever: FloatArray | None) -> _Pointwise:
         near = far = None
         if lever is not None:  # an arm: moments about the pivot
-            moment = load.axial_force(motion, omega=omega)
+            moment = setup.drive_sign * load.axial_force(motion, omega=omega)
             ratio = lever * np.cos(alpha)
             force = moment / ratio
-            torque = moment * arm_speed(motion) + dyn.friction_torque
+            torque = moment * setup.drive_sign * arm_speed(motion) + dyn.friction_torque
         elif tappet is not None:
             forces = tappet_forces(motion, load=load, omega=omega, tappet=tappet)
             force = forces.normal_force
@@ -177,9 +177,9 @@ def _model(setup: DynamicsSetup) -> _Model:
             torque = forces.torque + dyn.friction_torque
             ratio = forces.load_ratio
         else:
-            axial = load.axial_force(motion, omega=omega)
+            axial = setup.drive_sign * load.axial_force(motion, omega=omega)
             force = contact_force(axial, alpha)
-            torque = input_torque(axial, motion.v, friction_torque=dyn.friction_torque)
+            torque = input_torque(axial, setup.drive_sign * motion.v, friction_torque=dyn.friction_torque)
             ratio = np.cos(alpha)
         stress = hertz_stress(
             force, curvature=contact_curvature(rho, roller_radius=roller), length=length, modulus=modulus
@@ -278,6 +278,11 @@ def analyse_dynamics(
     runs = loss_runs(motion.phi, sampled.force < margin)
     if not runs and force_min.value < margin:  # lost only between samples or just before/after a joint
         runs = ((force_min.phi % TWO_PI, force_min.phi % TWO_PI),)
+    crossovers: tuple[float, ...] = ()
+    impacts: tuple[float, ...] = ()
+    if setup.positive_drive:  # the other flank takes over: crossovers, not jumps
+        runs = ()
+        crossovers, impacts = _crossovers(model, phi, sampled.force, cam, setup)
     findings = _findings(
         dyn,
         torsional=setup.arm_angle is not None and dyn.spring_arm is None,
@@ -315,7 +320,75 @@ def analyse_dynamics(
         torque_min=torque_min,
         torque_max=torque_max,
         hertz_stress_max=stress_max,
+        crossovers=crossovers,
+        impact_speeds=impacts,
     )
+
+
+def _crossovers(
+    model: _Model, phi: FloatArray, force: FloatArray, cam: Cam | None, setup: DynamicsSetup
+) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Where a positively driven follower's contact force changes sign, and the impact speed there.
+
+    Samples where the force vanishes (a rest: no spring holds a positively
+    driven follower, so a dwell loads neither flank) are passed over: the
+    driving flank changes only where the force on the two sides of a zero
+    stretch has opposite signs. A change between neighbouring samples is
+    refined by Brent's method on the exact model (when the cam is given); one
+    across a rest is placed where the rest ends, at the joint where the new
+    flank starts to drive. At a crossover the follower floats across the
+    clearance c while the force that would hold it grows at the rate of the
+    jerk: the gap closes as J·t³/6, so the roller meets the other flank after
+    t = (6c/J)^(1/3) at the relative speed J·t²/2 (Norton 2009, §8.11
+    "crossover shock"; J = |d³s/dt³| [mm/s³] on a slide, |d³ψ/dt³|·r on an
+    arm, r the distance from the pivot to the roller centre).
+    """
+    from scipy.optimize import brentq
+
+    scale = float(np.max(np.abs(force), initial=0.0))
+    live = np.flatnonzero(np.abs(force) > 1e-9 * scale)
+    if live.size < 2:
+        return (), ()
+    sign = force[live] > 0.0
+    joints = np.sort(np.asarray([bp.phi for bp in cam.program.breakpoints])) if cam is not None else None
+    found: list[float] = []
+    speeds: list[float] = []
+    for k in np.flatnonzero(sign != np.roll(sign, -1)):
+        i, n = int(live[k]), int(live[(k + 1) % live.size])
+        a, b = float(phi[i]), float(phi[n])
+        if b <= a:
+            b += TWO_PI
+        root = 0.5 * (a + b)
+        rest = []  # the joints between the last sample of one sign and the first of the other
+        if joints is not None and (n - i) % phi.size > 1:
+            rest = [q for q in np.concatenate((joints, joints + TWO_PI)) if a < q <= b]
+        if rest:  # across a rest: the new flank drives from the joint where the rest ends
+            root = float(max(rest))
+        elif cam is not None:
+
+            def f(p: float, exact: Cam = cam) -> float:
+                st = exact.state(np.array([p]))
+                return float(model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force[0])
+
+            if f(a) * f(b) < 0.0:
+                root = brentq(f, a, b, xtol=1e-12)
+        root %= TWO_PI
+        found.append(root)
+        if cam is not None and setup.clearance > 0.0:
+            speeds.append(_impact_speed(cam, root, setup))
+    return tuple(found), tuple(speeds)
+
+
+def _impact_speed(cam: Cam, phi: float, setup: DynamicsSetup) -> float:
+    """Speed [mm/s] at which the roller meets the other flank after a crossover at φ (Norton §8.11)."""
+    st = cam.state(np.array([phi]), side="right")
+    jerk = abs(float(st.motion.j[0])) * setup.omega**3  # mm/s³, or degrees/s³ of swing on an arm
+    if st.lever is not None:
+        jerk *= math.pi / 180.0 * float(st.lever[0])
+    if jerk <= 0.0:
+        return 0.0
+    t = (6.0 * setup.clearance / jerk) ** (1.0 / 3.0)
+    return 0.5 * jerk * t * t
 
 
 def _extremes(

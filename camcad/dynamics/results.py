@@ -102,6 +102,8 @@ class DynamicsResult:
     torque_min: Extreme | None = None
     torque_max: Extreme | None = None
     hertz_stress_max: Extreme | None = None
+    crossovers: tuple[float, ...] = ()  # rad, positive drive: where the driving flank (or roller) changes
+    impact_speeds: tuple[float, ...] = ()  # mm/s across the groove's clearance, one per crossover
 
     csv_header: ClassVar[tuple[str, ...]] = CSV_HEADER
 
@@ -152,6 +154,9 @@ class DynamicsResult:
             "speed_range_rpm": None if self.speed_range_rpm is None else list(self.speed_range_rpm),
             "warnings": list(self.warnings),
         }
+        if self.crossovers:
+            out["crossover_angles_deg"] = [_deg(p) for p in self.crossovers]
+            out["impact_speed_max_mm_per_s"] = max(self.impact_speeds, default=None)
         return out
 
     def table(self) -> FloatArray:

@@ -76,6 +76,15 @@ class DynamicsSetup:
     tappet_offset
         The guided tappet's axis offset [mm] as Hren et al. draw it (their
         Fig. 2 is a ccw cam): e for a ccw cam, −e for a cw cam, its mirror image.
+    positive_drive
+        Groove and conjugate cams: no spring holds the follower on; the
+        contact force changes sign where the other flank (or roller) takes
+        over, which is a crossover, not a jump.
+    clearance
+        A groove's radial clearance [mm] (the impact estimate at crossovers).
+    drive_sign
+        −1 for a conjugate pair's second plate: its roller pushes the follower
+        back, so its contact force is the generalised force with the sign turned.
     arm_angle
         Oscillating followers: the arm's direction at ψ = 0 in the machine
         frame [rad] (pivot → roller centre, or along the face towards the cam);
@@ -89,3 +98,6 @@ class DynamicsSetup:
     roller_radius: float = 0.0
     tappet_offset: float = 0.0
     arm_angle: float | None = None
+    positive_drive: bool = False
+    clearance: float = 0.0
+    drive_sign: float = 1.0

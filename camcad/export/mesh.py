@@ -39,7 +39,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import manifold3d
-import meshio
 import numpy as np
 import trimesh
 
@@ -56,7 +55,7 @@ from camcad.export._outline import (
 from camcad.export.atomic import atomic_write, atomic_write_bytes
 from camcad.export.spec import MeshSpec
 from camcad.fit.result import ProfileFit
-from camcad.geometry.plate import BoreOutline, Plate
+from camcad.geometry.plate import BoreOutline, Plate, circle_segments
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -64,7 +63,9 @@ if TYPE_CHECKING:
 __all__ = [
     "MESH_FORMATS",
     "VOLUME_RTOL",
+    "GrooveSolidResult",
     "SolidResult",
+    "build_groove_solid",
     "build_solid",
     "threemf_bytes",
     "write_meshes",
@@ -154,7 +155,7 @@ def _check_areas(
         )
     if cam is None:
         return spline, chord_bound, None, None
-    breaks = [b.phi for b in cam.program.breakpoints]
+    breaks = list(cam.program.pieces)
     signed, length = analytic_area(cam.profile, breaks)
     profile = abs(signed) - hole_area
     fit_bound = fit.max_error * length + AREA_ROUNDOFF * abs(signed)
@@ -165,6 +166,34 @@ def _check_areas(
             f"max fit error × length = {fit_bound:.3g} mm²"
         )
     return spline, chord_bound, profile, fit_bound
+
+
+def _checked_mesh(
+    solid: manifold3d.Manifold, holes: int, what: str, why: str = ""
+) -> tuple[trimesh.Trimesh, int]:
+    """The manifold as a trimesh, with its genus, after checks 1-2 of the module docstring.
+
+    Raises
+    ------
+    ExportError
+        When manifold3d reports an error, the genus is not ``holes``, or the
+        mesh is not closed and consistently wound; ``why`` follows the genus message.
+    """
+    status = solid.status()
+    if status != manifold3d.Error.NoError or solid.is_empty():
+        raise ExportError(f"solid check failed: manifold3d reports {status.name} for {what}")
+    genus = int(solid.genus())
+    if genus != holes:
+        raise ExportError(f"solid check failed: genus {genus} but {what} has {holes} through hole(s){why}")
+    raw = solid.to_mesh64()
+    mesh = trimesh.Trimesh(
+        vertices=np.asarray(raw.vert_properties, dtype=float)[:, :3],
+        faces=np.asarray(raw.tri_verts, dtype=np.int64),
+        process=False,
+    )
+    if not (mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0.0):
+        raise ExportError(f"solid check failed: the mesh of {what} is not a closed, consistently wound solid")
+    return mesh, genus
 
 
 def build_solid(fit: ProfileFit, plate: Plate, options: MeshSpec, *, cam: Cam | None = None) -> SolidResult:
@@ -199,23 +228,8 @@ def build_solid(fit: ProfileFit, plate: Plate, options: MeshSpec, *, cam: Cam | 
     polygon = sum(polygon_area(c) for c in contours)
     section = manifold3d.CrossSection(contours, manifold3d.FillRule.Positive)
     solid = manifold3d.Manifold.extrude(section, thickness)
-    status = solid.status()
-    if status != manifold3d.Error.NoError or solid.is_empty():
-        raise ExportError(f"solid check failed: manifold3d reports {status.name} for the extrusion")
-    genus = int(solid.genus())
-    if genus != holes:
-        raise ExportError(
-            f"solid check failed: genus {genus} but the plate has {holes} hole(s); "
-            "the profile or the bore outline self-intersects"
-        )
-    raw = solid.to_mesh64()
-    mesh = trimesh.Trimesh(
-        vertices=np.asarray(raw.vert_properties, dtype=float)[:, :3],
-        faces=np.asarray(raw.tri_verts, dtype=np.int64),
-        process=False,
-    )
-    if not (mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0.0):
-        raise ExportError("solid check failed: the mesh is not a closed, consistently wound solid")
+    why = "; the profile or the bore outline self-intersects"
+    mesh, genus = _checked_mesh(solid, holes, "the plate", why)
     euler_genus = (2 - int(mesh.euler_number)) // 2
     if euler_genus != holes:
         raise ExportError(f"solid check failed: Euler characteristic gives genus {euler_genus}, not {holes}")
@@ -240,6 +254,139 @@ def build_solid(fit: ProfileFit, plate: Plate, options: MeshSpec, *, cam: Cam | 
         profile_area=profile,
         chord_area_bound=chord_bound,
         fit_area_bound=fit_bound,
+    )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GrooveSolidResult:
+    """A groove cam's blank with its groove pocket, and the numbers its checks compared.
+
+    Attributes
+    ----------
+    mesh
+        Closed triangle mesh [mm]; the blank spans z ∈ [0, thickness], the
+        groove is open at the top face z = thickness.
+    volume
+        Mesh volume [mm³], equal to ``expected_volume`` to 1e-6 relative.
+    expected_volume
+        (blank polygon − bore polygon) × thickness − groove polygon × depth [mm³].
+    genus
+        Genus of the solid (the bore; the blind groove adds none).
+    groove_polygon_area, groove_spline_area, groove_exact_area
+        The groove's area between the flanks [mm²]: of the extruded
+        polygons, of the fitted flank splines (exact for cubics) and of the
+        exact flank curves (Green's theorem on ``cam.offset``); each pair
+        agrees within its bound (chord tolerance × length, fit error × length).
+    blank_area
+        Exact blank area less the exact bore area [mm²].
+    """
+
+    mesh: trimesh.Trimesh
+    volume: float
+    expected_volume: float
+    genus: int
+    thickness: float
+    depth: float
+    groove_polygon_area: float
+    groove_spline_area: float
+    groove_exact_area: float | None
+    blank_area: float
+
+
+def build_groove_solid(
+    flanks: tuple[ProfileFit, ProfileFit],
+    plate: Plate,
+    options: MeshSpec,
+    *,
+    outer_radius: float,
+    depth: float,
+    cam: Cam | None = None,
+    offsets: tuple[float, float] | None = None,
+) -> GrooveSolidResult:
+    """The groove cam: a disc of ``outer_radius`` [mm], bore and keyway, the groove pocket ``depth`` deep.
+
+    Parameters
+    ----------
+    flanks
+        The certified fits of the inner and outer flank (``fit_cam_profile(cam, offset=…)``).
+    plate
+        Thickness, bore and keyway [mm].
+    options
+        ``[mesh]``: ``chord_tolerance`` [mm].
+    outer_radius, depth
+        The blank's radius and the groove's depth below the top face [mm].
+    cam, offsets
+        The exact cam and the flanks' offsets from its profile
+        (:func:`camcad.geometry.groove.flank_offsets`): when given, the flank
+        splines' areas are checked against the exact flank curves' too.
+
+    Raises
+    ------
+    ExportError
+        When the boolean fails, the mesh is not a closed solid of the right
+        genus, or any volume or area check fails.
+    """
+    tol = options.chord_tolerance
+    thickness = plate.thickness
+    n = circle_segments(outer_radius, tol)
+    angle = np.arange(n) * (2.0 * math.pi / n)
+    rim = np.column_stack((outer_radius * np.cos(angle), outer_radius * np.sin(angle)))
+    blank_contours = [rim]
+    if plate.bore is not None:
+        blank_contours.append(oriented(np.asarray(plate.bore.polygon(tol)), ccw=False))
+    inner, outer = (oriented(np.asarray(flatten_bspline(f.clamped, tol)), ccw=True) for f in flanks)
+    groove_contours = [outer, inner[::-1].copy()]
+    blank = manifold3d.Manifold.extrude(
+        manifold3d.CrossSection(blank_contours, manifold3d.FillRule.Positive), thickness
+    )
+    reach = 1.0  # mm above the top face, so the cut shares no face with the blank
+    pocket = manifold3d.Manifold.extrude(
+        manifold3d.CrossSection(groove_contours, manifold3d.FillRule.Positive), depth + reach
+    ).translate((0.0, 0.0, thickness - depth))
+    solid = blank - pocket
+    mesh, genus = _checked_mesh(solid, len(blank_contours) - 1, "the groove cam")
+    blank_polygon = sum(polygon_area(c) for c in blank_contours)
+    groove_polygon = sum(polygon_area(c) for c in groove_contours)
+    expected = blank_polygon * thickness - groove_polygon * depth
+    volume = float(mesh.volume)
+    if not math.isclose(volume, expected, rel_tol=VOLUME_RTOL):
+        raise ExportError(
+            f"solid check failed: groove cam volume {volume:.9g} mm³ differs from the extruded areas' "
+            f"{expected:.9g} mm³ by more than {VOLUME_RTOL:g} relative"
+        )
+    hole_area = plate.bore.area if plate.bore is not None else 0.0
+    blank_area = math.pi * outer_radius**2 - hole_area
+    spline_areas = [abs(bspline_area(f.clamped)) for f in flanks]
+    lengths = [bspline_length(f.clamped) for f in flanks]
+    groove_spline = spline_areas[1] - spline_areas[0]
+    chord_bound = tol * sum(lengths) + AREA_ROUNDOFF * spline_areas[1]
+    if abs(groove_polygon - groove_spline) > chord_bound:
+        raise ExportError(
+            f"solid check failed: the groove polygon's area {groove_polygon:.9g} mm² differs from the flank "
+            f"splines' {groove_spline:.9g} mm² by more than the chord bound {chord_bound:.3g} mm²"
+        )
+    exact = None
+    if cam is not None and offsets is not None:
+        breaks = list(cam.program.pieces)
+        exact_areas = [abs(analytic_area(lambda p, d=d: cam.offset(p, d), breaks)[0]) for d in offsets]
+        exact = exact_areas[1] - exact_areas[0]
+        fit_bound = sum(f.max_error * length for f, length in zip(flanks, lengths, strict=True))
+        if abs(groove_spline - exact) > fit_bound + AREA_ROUNDOFF * exact_areas[1]:
+            raise ExportError(
+                f"solid check failed: the flank splines' groove area {groove_spline:.9g} mm² differs from "
+                f"the exact flanks' {exact:.9g} mm² by more than fit error × length {fit_bound:.3g} mm²"
+            )
+    return GrooveSolidResult(
+        mesh=mesh,
+        volume=volume,
+        expected_volume=expected,
+        genus=genus,
+        thickness=thickness,
+        depth=depth,
+        groove_polygon_area=groove_polygon,
+        groove_spline_area=groove_spline,
+        groove_exact_area=exact,
+        blank_area=blank_area,
     )
 
 
@@ -299,6 +446,8 @@ def threemf_bytes(mesh: trimesh.Trimesh, *, name: str = "cam") -> bytes:
 
 
 def _write_vtu(tmp: Path, mesh: trimesh.Trimesh) -> None:
+    import meshio  # here: only the VTU format needs it
+
     cells = [meshio.CellBlock("triangle", np.asarray(mesh.faces, dtype=np.int64))]
     meshio.write(tmp, meshio.Mesh(np.asarray(mesh.vertices, dtype=float), cells), file_format="vtu")
 
@@ -321,7 +470,7 @@ def _encoded(mesh: trimesh.Trimesh, fmt: str) -> bytes:
 
 def write_meshes(
     outdir: str | os.PathLike[str],
-    solid: SolidResult,
+    solid: SolidResult | GrooveSolidResult,
     formats: Sequence[str] = ("stl",),
     *,
     stem: str = "cam",
@@ -333,7 +482,7 @@ def write_meshes(
     outdir
         Existing output folder.
     solid
-        A checked solid from :func:`build_solid`.
+        A checked solid from :func:`build_solid` or :func:`build_groove_solid`.
     formats
         Any of ``stl, obj, ply, off, 3mf, vtu`` (``[mesh].formats``); STL is
         written whether listed or not.

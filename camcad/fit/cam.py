@@ -18,9 +18,14 @@ REFINEMENTS = 3  # halvings of the step when the samples are too few for the tol
 
 
 def fit_cam_profile(
-    cam: Cam, *, tolerance: float = 1e-3, max_control_points: int | None = None, step: float | None = None
+    cam: Cam,
+    *,
+    tolerance: float = 1e-3,
+    max_control_points: int | None = None,
+    step: float | None = None,
+    offset: float = 0.0,
 ) -> ProfileFit:
-    """Certified B-spline of ``cam.profile`` over one turn.
+    """Certified B-spline of ``cam.profile`` (or of its offset ``cam.offset(φ, offset)``) over one turn.
 
     Samples the exact profile (breakpoints included), puts knots at the
     motion breakpoints, and certifies the result against ``cam.profile``
@@ -46,6 +51,12 @@ def fit_cam_profile(
         samples leave room for halves the step (up to ``REFINEMENTS``
         times) before giving up.
 
+    offset
+        Fit the profile offset outward by this distance [mm] instead of the
+        profile itself (a groove's flanks,
+        :func:`camcad.geometry.groove.groove_flanks`); the certificate is then
+        against ``cam.offset(φ, offset)``.
+
     Raises
     ------
     FitError
@@ -67,8 +78,8 @@ def fit_cam_profile(
         try:
             return _fit_closed(
                 phi,
-                np.asarray(cam.profile(phi).point),
-                exact=lambda p: cam.profile(p).point,
+                np.asarray(cam.offset(phi, offset).point),
+                exact=lambda p: cam.offset(p, offset).point,
                 breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
                 tolerance=tolerance,
                 max_control_points=max_control_points,

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
@@ -33,7 +33,8 @@ from camcad.geometry.followers import (
     TranslatingFlat,
     TranslatingRoller,
 )
-from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
+from camcad.geometry.followers.tied import TiedRoller
+from camcad.geometry.spec import ConjugateSpec, FollowerKind, FollowerSpec, Rotation
 from camcad.motion.program import Motion, MotionProgram, Side
 from camcad.motion.segments import SegmentSpec
 
@@ -155,6 +156,10 @@ class Cam:
     follower: FollowerSpec
     rotation: Rotation = Rotation.CCW
     sample_step: float = math.radians(0.1)
+    conjugate: ConjugateSpec | None = None  # set: this is the pair's second plate, driving the tied roller
+    _memo: dict[str, Follower] = field(  # the follower module, built once (see kinematics)
+        default_factory=dict, init=False, compare=False, hash=False, repr=False
+    )
 
     @classmethod
     def from_design(cls, design: _CamDesign) -> Cam:
@@ -171,8 +176,30 @@ class Cam:
 
     @property
     def kinematics(self) -> Follower:
-        """The follower module at this cam's base radius."""
-        return follower_from_spec(self.follower, self.base_radius)
+        """The follower module at this cam's base radius (the tied roller on a pair's second plate).
+
+        Built once per cam: every evaluation of the cam's curves asks for it.
+        """
+        if "kinematics" not in self._memo:
+            self._memo["kinematics"] = self._follower()
+        return self._memo["kinematics"]
+
+    def _follower(self) -> Follower:
+        first = follower_from_spec(self.follower, self.base_radius)
+        if self.conjugate is None:
+            return first
+        top_phi = max((bp.phi for bp in self.program.breakpoints), key=lambda p: float(self.motion(p).s[0]))
+        return TiedRoller.on(
+            first,
+            roller_radius=self.conjugate.roller_radius or first.roller_radius,
+            angle=self.conjugate.angle,
+            top=first.element(self.motion(top_phi)),  # type: ignore[arg-type]
+            base_radius=self.base_radius,
+        )
+
+    def partner(self, conjugate: ConjugateSpec) -> Cam:
+        """The conjugate pair's second plate, on the same shaft, driving the tied second roller."""
+        return replace(self, conjugate=conjugate)
 
     @property
     def is_roller(self) -> bool:

@@ -6,7 +6,15 @@ import enum
 import math
 from dataclasses import dataclass
 
-__all__ = ["FollowerKind", "FollowerSpec", "Rotation", "arm_problem"]
+__all__ = [
+    "CamStyle",
+    "ConjugateSpec",
+    "FollowerKind",
+    "FollowerSpec",
+    "GrooveSpec",
+    "Rotation",
+    "arm_problem",
+]
 
 
 class Rotation(enum.Enum):
@@ -14,6 +22,37 @@ class Rotation(enum.Enum):
 
     CCW = "ccw"
     CW = "cw"
+
+
+class CamStyle(enum.Enum):
+    """How the cam drives the follower: a plate (a spring holds the follower on), a groove or a pair."""
+
+    PLATE = "plate"
+    GROOVE = "groove"
+    CONJUGATE = "conjugate"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GrooveSpec:
+    """A groove (face) cam's groove: ``depth`` below the face and radial ``clearance``, both mm."""
+
+    depth: float = 10.0
+    clearance: float = 0.02
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ConjugateSpec:
+    """The second roller of a conjugate pair: its ``angle`` [rad] from the first and radius [mm].
+
+    A slide's second roller stands at ``angle`` about the cam axis (180°: on
+    the opposite side, a yoke); an arm's is on a second arm of the same length
+    on the same pivot, ``angle`` the included angle between the arms. None of
+    ``roller_radius``: the first roller's.
+    """
+
+    angle: float = math.pi
+    roller_radius: float | None = None
+    single_plate: bool = False  # a constant-breadth cam: both rollers on one plate (slides, 180°)
 
 
 class FollowerKind(enum.Enum):
