@@ -18,10 +18,13 @@ from camcad._version import __version__
 from camcad.design import Design
 from camcad.dynamics import DynamicsResult
 from camcad.extremes import SIDE_WORDS, Side, extremes_rows
+from camcad.fea.results import FeaResult
 from camcad.findings import Finding
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
 from camcad.motion.program import Motion
+from camcad.motion.table import table_summary
+from camcad.positive import PositiveDrive
 
 if TYPE_CHECKING:
     from camcad.export.gcode import GcodeProgram
@@ -66,17 +69,26 @@ class Analysis:
     gcode: GcodeProgram | None = None
     timings: dict[str, float] = field(default_factory=dict)
     stage_findings: tuple[Finding, ...] = ()
+    positive: PositiveDrive = field(default_factory=PositiveDrive)
+    fea: FeaResult | None = None  # the finite-element check, when run ([fea] present, or asked for)
 
     @property
     def findings(self) -> tuple[Finding, ...]:
         """Every broken limit of every stage, hard ones first (see :mod:`camcad.findings`)."""
-        found = (*self.geometry.findings, *self.dynamics.findings, *self.stage_findings)
+        found = (
+            *self.geometry.findings,
+            *self.positive.findings,
+            *self.dynamics.findings,
+            *self.stage_findings,
+            *(self.fea.findings if self.fea is not None else ()),
+        )
         return tuple(sorted(found, key=lambda f: not f.hard))
 
     @property
     def warnings(self) -> list[str]:
         """Every non-fatal message of every stage: soft findings and notes."""
-        return [*self.geometry.warnings, *self.dynamics.warnings]
+        fea = list(self.fea.warnings) if self.fea is not None else []
+        return [*self.geometry.warnings, *self.dynamics.warnings, *fea]
 
     @property
     def violations(self) -> list[str]:
@@ -91,11 +103,14 @@ class Analysis:
             "motion": motion_summary(self.cam, self.motion),
             "geometry": self.geometry.summary(),
             "dynamics": self.dynamics.summary(),
+            **self.positive.summary(),
         }
         if self.fit is not None:
             out["fit"] = self.fit.summary()
         if self.gcode is not None:
             out["gcode"] = self.gcode.summary()
+        if self.fea is not None:
+            out["fea"] = self.fea.summary()
         out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]
@@ -144,4 +159,7 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
         }
         for j in cam.program.joints()
     ]
+    if cam.program.blend_points:  # joints whose values a polynomial or inclined sine took from a neighbour
+        out["blend_points_deg"] = [round(math.degrees(bp.phi), 6) for bp in cam.program.blend_points]
+    out.update(table_summary(cam.program.segments, u))  # a point table's residuals and flags
     return out

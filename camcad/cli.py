@@ -68,6 +68,8 @@ def _cmd_build(args: argparse.Namespace) -> int:
         print(f"camcad {__version__}: building {design.cam.name!r} from {args.design}", file=sys.stderr)
     result = build(design, args.output, only=only, progress=_progress(args.quiet), strict=args.strict)
     warnings = result.analysis.warnings
+    for note in result.notes:  # an output left out (cam.step without OpenCASCADE): said even with -q
+        print(f"note: {note}", file=sys.stderr)
     if not args.quiet:
         for w in warnings:
             print(f"warning: {w}", file=sys.stderr)
@@ -131,7 +133,10 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
             "max contact stress",
             _fmt(dyn.get("hertz_stress_max_MPa"), " MPa", 1) + _at(dyn, "hertz_stress_max"),
         ),
-        ("follower jump", _fmt(dyn.get("jump"))),
+        (
+            "follower jump",
+            "none (positive drive)" if {"groove", "second_plate"} & set(summary) else _fmt(dyn.get("jump")),
+        ),
         (
             "fit control points",
             f"{fit['control_points']} (max error {fit['max_error_mm'] * 1000:.3f} µm)" if fit else "—",
@@ -139,13 +144,64 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
     ]
 
 
+def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+    """The rows a groove or a conjugate pair adds to ``camcad check``: flanks, second plate, crossovers."""
+    rows: list[tuple[str, str]] = []
+    groove, second = summary.get("groove"), summary.get("second_plate")
+    if groove is not None:
+        rows += [
+            ("groove width", _fmt(groove["width_mm"], " mm")),
+            ("largest cutter radius", _fmt(groove["tool_radius_max_mm"], " mm")),
+            ("outer flank reach", _fmt(groove["outer_flank_reach_mm"], " mm")),
+        ]
+    if second is not None:
+        geo = second["geometry"]
+        rows += [
+            (
+                "2nd plate pressure angle",
+                _fmt(geo["pressure_angle_max_deg"], "°", 2) + _at(geo, "pressure_angle_max"),
+            ),
+            (
+                "2nd plate min curvature",
+                _fmt(geo["curvature_radius_min_mm"], " mm") + _at(geo, "curvature_radius_min"),
+            ),
+        ]
+    if groove is not None or second is not None:
+        dyn = summary["dynamics"]
+        crossings = ", ".join(f"{a:.1f}°" for a in dyn.get("crossover_angles_deg", [])) or "none"
+        rows.append(("crossovers", crossings))
+        if dyn.get("impact_speed_max_mm_per_s") is not None:
+            rows.append(("max impact speed", _fmt(dyn["impact_speed_max_mm_per_s"], " mm/s", 1)))
+    return rows
+
+
+def _fea_rows(fea: dict[str, Any]) -> list[tuple[str, str]]:
+    """The finite-element check's rows of ``camcad check``: the peak von Mises stress, then each case."""
+    limit = fea.get("allowable_stress_MPa")
+    peak = _fmt(fea.get("von_mises_max_MPa"), " MPa", 1)
+    if fea.get("von_mises_max_angle_deg") is not None:
+        peak += f" at {fea['von_mises_max_angle_deg']:.1f}°, {fea['von_mises_max_where']}"
+    rows = [("FE max von Mises", peak + (f" (limit {limit:g} MPa)" if limit is not None else ""))]
+    for case in fea.get("cases", []):
+        rows.append(
+            (
+                f"  FE case {case['case']}",
+                f"{case['label']} at {case['angle_deg']:.1f}°: von Mises {case['von_mises_max_MPa']:.1f} MPa "
+                f"(Hertz {case['hertz_stress_MPa']:.1f} MPa)",
+            )
+        )
+    return rows
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     from camcad.design import load_design
     from camcad.pipeline import analyse
 
     design = load_design(args.design)
-    analysis = analyse(design, strict=False, toolpath=True)
-    rows = _check_rows(analysis.summary(), design)
+    analysis = analyse(design, strict=False, toolpath=True, fea=args.fea or design.fea is not None)
+    rows = _check_rows(analysis.summary(), design) + _positive_rows(analysis.summary())
+    if analysis.fea is not None:
+        rows += _fea_rows(analysis.summary()["fea"])
     width = max(len(k) for k, _ in rows)
     print(f"{design.cam.name} ({args.design})")
     for key, value in rows:
@@ -194,21 +250,13 @@ def _cmd_size(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _terminal_text(text: str) -> str:
-    """One line of printable text: control characters (a newline in a cam name) become spaces."""
-    return " ".join("".join(c if c.isprintable() else " " for c in text).split())
-
-
 def _cmd_compare(args: argparse.Namespace) -> int:
     from camcad.design import load_design
     from camcad.pipeline import analyse
-    from camcad.report import compare_table, write_compare
+    from camcad.report import compare_text, write_compare
 
     analyses = [analyse(load_design(p), strict=False, toolpath=False) for p in args.designs]
-    table = [[_terminal_text(cell) for cell in row] for row in compare_table(analyses)]
-    widths = [max(len(row[i]) for row in table) for i in range(len(table[0]))]
-    for row in table:
-        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())
+    print(compare_text(analyses, width=100))  # names as A, B, … in a legend when they do not fit
     if args.output:
         from camcad.export.atomic import staged_folder
 
@@ -216,6 +264,136 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             write_compare(analyses, staging.path / "compare.html")
         path = Path(args.output) / "compare.html"
         print(f"wrote {path}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _design_mapping(path: str) -> dict[str, Any]:
+    """A design file's TOML mapping, after the schema accepted the file (``optimize``, ``sweep``)."""
+    import tomllib
+
+    from camcad.design import load_design
+
+    load_design(path)
+    return tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
+
+
+def _cmd_optimize(args: argparse.Namespace) -> int:
+    from camcad.explore.files import write_optimize
+    from camcad.explore.measures import measure, parse_limit
+    from camcad.explore.optimize import Problem, optimize
+    from camcad.explore.space import parse_variable
+
+    data = _design_mapping(args.design)
+    problem = Problem(
+        data=data,
+        source=args.design,
+        variables=tuple(
+            parse_variable(v, data, flag="--vary", counted=False, source=args.design) for v in args.vary
+        ),
+        objectives=tuple(measure(m.strip(), "--minimize") for m in ",".join(args.minimize).split(",")),
+        limits=tuple(parse_limit(text) for text in args.limit),
+        method=args.method,
+        starts=args.starts,
+        points=args.points,
+    )
+    say = None if args.quiet else (lambda text: print(f"  trying {text}", file=sys.stderr))
+    result = optimize(problem, progress=say)
+    if len(result.tried) > 1:  # one optimum per combination of the discrete choices
+        for cand in result.tried:
+            objective = ", ".join(f"{k} = {_fmt(v)}" for k, v in cand.objectives.items())
+            choices = ", ".join(f"{k} = {v}" for k, v in cand.values.items() if not isinstance(v, float))
+            print(f"tried {choices}: {objective}{'' if cand.feasible else ' (infeasible)'}")
+    shown = [result.best] if result.best is not None else list(result.front)
+    for i, cand in enumerate(shown, start=1):
+        head = "optimum" if result.best is not None else f"Pareto point {i}"
+        objective = ", ".join(f"{k} = {_fmt(v)}" for k, v in cand.objectives.items())
+        print(f"{head}{'' if cand.feasible else ' (INFEASIBLE)'}: {objective}")
+        for name, value in cand.values.items():
+            print(f"  {name} = {value:.6g}" if isinstance(value, float) else f"  {name} = {value}")
+        for c in cand.constraints:
+            limit = f" (limit {c.limit:g})" if math.isfinite(c.limit) else ""
+            print(f"  {'*' if c.active else ' '} {c.name:<48} {_fmt(c.value)}{limit}")
+        for bound in cand.bounds:
+            print(f"  * {bound}")
+    print(f"active constraints and bounds are marked *; {result.evaluations} analyses")
+    for path in write_optimize(problem, result, args.output):
+        print(f"wrote {path}", file=sys.stderr)
+    if not any(c.feasible for c in shown):
+        raise DesignLimitError("no design within the ranges meets every limit (see optimize.json)")
+    return EXIT_OK
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from camcad.errors import UsageError
+    from camcad.explore.measures import measure, parse_limit
+    from camcad.explore.space import grid_points, lhs_points, parse_variable
+    from camcad.explore.sweep import SweepPlan, sweep
+
+    data = _design_mapping(args.design)
+    counted = args.samples is None
+    variables = tuple(
+        parse_variable(g, data, flag="--grid", counted=counted, source=args.design) for g in args.grid
+    )
+    if not variables:
+        raise UsageError("--grid", "give at least one, e.g. --grid base_radius=30:80:51")
+    names = [m.strip() for m in args.pareto.split(",")]
+    if len(names) != 2:
+        raise UsageError("--pareto", f"{args.pareto!r}: name two quantities, e.g. base_radius,contact_stress")
+    if args.chunk_size < 1:
+        raise UsageError("--chunk-size", f"{args.chunk_size} is not allowed (allowed: 1 or more)")
+    points = grid_points(variables) if counted else lhs_points(variables, args.samples, seed=args.seed)
+    plan = SweepPlan(
+        data=data,
+        source=args.design,
+        variables=variables,
+        points=tuple(points),
+        limits=tuple(parse_limit(text) for text in args.limit),
+        pareto=(measure(names[0], "--pareto"), measure(names[1], "--pareto")),
+        sampling="grid" if counted else f"Latin hypercube, seed {args.seed}",
+        chunk_size=args.chunk_size,
+    )
+
+    def report(done: int, total: int) -> None:  # on a terminal only: one line rewritten in place
+        print(f"\r  {done}/{total} chunks", end="" if done < total else "\n", file=sys.stderr, flush=True)
+
+    jobs = args.jobs if args.jobs is not None else (os.cpu_count() or 1)
+    result = sweep(
+        plan,
+        args.output,
+        fmt=args.format,
+        jobs=jobs,
+        scheduler=args.scheduler,
+        progress=None if args.quiet or not sys.stderr.isatty() else report,
+    )
+    rows = result.rows
+    counts = {s: sum(1 for r in rows if r["status"] == s) for s in ("ok", "limit", "invalid")}
+    print(
+        f"{len(rows)} designs: {counts['ok']} ok, {counts['limit']} breaking a limit, "
+        f"{counts['invalid']} invalid; {sum(1 for r in rows if r['feasible'])} feasible, "
+        f"{sum(1 for r in rows if r['pareto'])} on the Pareto front"
+        + (f" ({result.resumed_chunks} chunks resumed)" if result.resumed_chunks else "")
+    )
+    for path in result.files:
+        print(f"wrote {path}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _cmd_serve(args: argparse.Namespace) -> int:
+    from camcad.errors import UsageError
+    from camcad.serve import serve
+
+    if not 0 <= args.port <= 65535:
+        raise UsageError("--port", f"{args.port} is not a port (allowed: 0 for a free one, or 1 to 65535)")
+    serve(args.design, port=args.port, open_browser=args.open)  # until Ctrl-C: exit 130
+    return EXIT_OK
+
+
+def _cmd_schema(args: argparse.Namespace) -> int:
+    import json
+
+    from camcad.design.editor_schema import design_json_schema
+
+    print(json.dumps(design_json_schema(), indent=2, ensure_ascii=False))
     return EXIT_OK
 
 
@@ -247,7 +425,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="output folder (created; files replaced)")
     p.add_argument(
         "--only",
-        help="comma-separated outputs to write: tables, dxf, stl, gcode, report (summary.json always)",
+        help="comma-separated outputs to write: tables, dxf, stl, step, gcode, fea, report (summary.json "
+        "always; fea = stress.vtu, by default only with a [fea] table)",
     )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     p.add_argument("--timings", action="store_true", help="print the seconds each stage took (stdout)")
@@ -260,6 +439,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("check", help="validate and analyse without writing; exit 3 if a limit is violated")
     p.add_argument("design", help="design file (TOML)")
+    p.add_argument("--fea", action="store_true", help="run the finite-element check (default: with [fea])")
     p.set_defaults(handler=_cmd_check)
 
     p = sub.add_parser("size", help="smallest base radius meeting the pressure-angle and curvature limits")
@@ -278,6 +458,76 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("laws", help="list the motion laws and their parameters")
     p.set_defaults(handler=_cmd_laws)
+
+    p = sub.add_parser("schema", help="print the JSON Schema of the design file (for editors)")
+    p.set_defaults(handler=_cmd_schema)
+
+    p = sub.add_parser("serve", help="edit a design live in the browser (local web page on 127.0.0.1)")
+    p.add_argument("design", help="design file (TOML)")
+    p.add_argument("--port", type=int, default=0, help="port on 127.0.0.1 (default: a free one)")
+    p.add_argument("--open", action="store_true", help="open the page in the default browser")
+    p.set_defaults(handler=_cmd_serve)
+
+    p = sub.add_parser("optimize", help="constrained optimisation over design-file keys, or a Pareto front")
+    p.add_argument("design", help="design file (TOML)")
+    p.add_argument(
+        "--minimize",
+        action="append",
+        required=True,
+        metavar="QUANTITY",
+        help="base_radius, pressure_angle, contact_stress, torque, …; two (comma or repeated) for a front",
+    )
+    p.add_argument(
+        "--vary",
+        action="append",
+        default=[],
+        metavar="NAME=LOW:HIGH|A,B,…",
+        help="a variable: a range, or choices tried one by one (repeat)",
+    )
+    p.add_argument(
+        "--limit",
+        action="append",
+        default=[],
+        metavar="QUANTITY<=VALUE",
+        help="a limit besides the design's own (pressure angle, allowable stress, no undercut)",
+    )
+    p.add_argument("--method", default="slsqp", help="slsqp (default) or trust-constr")
+    p.add_argument("--starts", type=int, default=1, help="local searches: the design's values, then LHS")
+    p.add_argument("--points", type=int, default=7, help="points of a two-objective front (default 7)")
+    p.add_argument("-o", "--output", required=True, help="folder for the result files")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    p.set_defaults(handler=_cmd_optimize)
+
+    p = sub.add_parser("sweep", help="analyse a grid or sample of design variants")
+    p.add_argument("design", help="design file (TOML)")
+    p.add_argument(
+        "--grid",
+        action="append",
+        default=[],
+        metavar="NAME=START:STOP:COUNT|A,B,…",
+        help="a variable and its values (repeat); with --samples a range START:STOP",
+    )
+    p.add_argument("--samples", type=int, help="Latin-hypercube sampling of this many designs, not a grid")
+    p.add_argument("--seed", type=int, default=0, help="seed of the Latin hypercube (default 0)")
+    p.add_argument(
+        "--limit",
+        action="append",
+        default=[],
+        metavar="QUANTITY<=VALUE",
+        help="a limit judged in the feasible column besides the design's own",
+    )
+    p.add_argument(
+        "--pareto",
+        default="base_radius,contact_stress",
+        help="the two minimised quantities of the front (default base_radius,contact_stress)",
+    )
+    p.add_argument("--format", default="parquet", help="table format: parquet (default) or csv")
+    p.add_argument("--jobs", type=int, help="local worker processes (default: every core; 1: this process)")
+    p.add_argument("--scheduler", help="a Dask scheduler address, e.g. tcp://host:8786 (instead of --jobs)")
+    p.add_argument("--chunk-size", type=int, default=16, help="designs per unit of work (default 16)")
+    p.add_argument("-o", "--output", required=True, help="folder for sweep.parquet (or .csv) and sweep.html")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    p.set_defaults(handler=_cmd_sweep)
     return parser
 
 

@@ -27,6 +27,8 @@ from camcad.export.records import write_csv, write_json, write_text
 from camcad.findings import Finding, Severity
 from camcad.fit import fit_cam_profile
 from camcad.geometry import Cam, analyse_geometry, undercut_error
+from camcad.positive import analyse_positive_drive, fit_positive_drive, plan_partner
+from camcad.toolpath.spec import Machine
 
 __all__ = [
     "OUTPUT_GROUPS",
@@ -44,10 +46,20 @@ Progress = Callable[[str, float], None]
 """Called after each stage with its name and its duration [s]."""
 
 OUTPUT_GROUPS: dict[str, tuple[str, ...]] = {
-    "tables": ("motion.csv", "profile.csv", "dynamics.csv", "points.csv", "lift.csv"),
-    "dxf": ("profile.dxf", "profile_poly.dxf"),
+    "tables": (
+        "motion.csv",
+        "profile.csv",
+        "dynamics.csv",
+        "points.csv",
+        "lift.csv",
+        "polar.txt",
+        "cam_table.csv",
+    ),
+    "dxf": ("profile.dxf", "profile_poly.dxf", "profile_arcs.dxf"),
     "stl": ("cam.stl",),
+    "step": ("cam.step",),  # needs the extra camcad[step]; skipped with a note without it
     "gcode": ("cam.ngc",),
+    "fea": ("stress.vtu",),  # the FE check (extra camcad[fea]); by default only when [fea] is present
     "report": ("report.html",),
 }
 """What ``build --only`` selects; ``summary.json`` is always written."""
@@ -67,6 +79,7 @@ class BuildResult:
     analysis: Analysis
     outdir: Path
     files: tuple[Path, ...]
+    notes: tuple[str, ...] = ()  # outputs left out and why (cam.step without OpenCASCADE), one line each
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -100,6 +113,7 @@ def analyse(
     toolpath: bool = True,
     strict: bool = True,
     progress: Progress | None = None,
+    fea: bool = False,
 ) -> Analysis:
     """Run motion → geometry → dynamics → fit → toolpath plan.
 
@@ -117,6 +131,10 @@ def analyse(
         when geometry already found one.
     progress
         Called after each stage with its name and duration.
+    fea
+        Run the finite-element check of the plate (:mod:`camcad.fea`) with the
+        design's ``[fea]`` table, or its defaults. Off by default: it is the
+        slowest stage (``build`` and ``check`` turn it on for a design with ``[fea]``).
 
     Raises
     ------
@@ -139,7 +157,8 @@ def analyse(
         ),
     )
     motion = cam.motion(geometry.phi)
-    hard = [f for f in geometry.findings if f.hard]
+    positive = analyse_positive_drive(design, cam)  # a groove's flanks, a conjugate pair's second plate
+    hard = [f for f in (*geometry.findings, *positive.findings) if f.hard]
     if hard and strict:
         if geometry.undercut is not None:
             raise undercut_error(geometry, min_curvature_radius=design.min_curvature_radius)
@@ -159,21 +178,35 @@ def analyse(
     later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
     fitted = planned = None
     if fit and not hard:
-        fitted = _limited(
-            lambda: fit_cam_profile(
-                cam, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
-            ),
-            timings=timings,
-            progress=progress,
-            stage="fit",
-            strict=strict,
-            found=later,
-        )
+
+        def fit_all() -> tuple[Any, Any]:  # the profile, then a groove's flanks or the second plate
+            limits = {"tolerance": design.fit.tolerance, "max_control_points": design.fit.max_control_points}
+            return fit_cam_profile(cam, **limits), fit_positive_drive(positive, cam, **limits)
+
+        fitted, positive = _limited(
+            fit_all, timings=timings, progress=progress, stage="fit", strict=strict, found=later
+        ) or (None, positive)
+    rotary = design.gcode.machine is Machine.ROTARY  # X + A/C in inverse time (camcad.toolpath.rotary)
     if toolpath and not hard:
         from camcad.toolpath import plan_toolpath
+        from camcad.toolpath.groove import plan_groove
+        from camcad.toolpath.rotary import plan_rotary
 
+        groove = positive.groove is not None  # a groove cam: slot and flank passes (camcad.toolpath.groove)
         planned = _limited(
-            lambda: plan_toolpath(
+            lambda: plan_groove(
+                cam,
+                design.gcode,
+                name=design.cam.name,
+                thickness=design.cam.thickness,
+                depth=design.groove.depth,
+                clearance=design.groove.clearance,
+                bore=design.cam.bore,
+            )
+            if groove
+            else plan_rotary(cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness)
+            if rotary
+            else plan_toolpath(
                 cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
             ),
             timings=timings,
@@ -182,11 +215,26 @@ def analyse(
             strict=strict,
             found=later,
         )
+    if planned is not None and positive.second_plate:
+        first = timings["toolpath"]
+        positive = _limited(
+            lambda: plan_partner(positive, design),
+            timings=timings,
+            progress=progress,
+            stage="toolpath",
+            strict=strict,
+            found=later,
+        ) or positive
+        timings["toolpath"] += first  # both plates' plans
+    fea_result = None
+    if fea and not hard:
+        fea_result = _timed(timings, progress, "fea", lambda: _fea_check(design, cam, dynamics))
     program = None
     if planned is not None:
         from camcad.export.gcode import render_program
+        from camcad.export.gcode.rotary import render_rotary_program
 
-        program = render_program(planned, design.gcode.dialect)
+        program = (render_rotary_program if rotary else render_program)(planned, design.gcode.dialect)
     return Analysis(
         design=design,
         cam=cam,
@@ -194,11 +242,25 @@ def analyse(
         geometry=geometry,
         dynamics=dynamics,
         fit=fitted,
-        toolpath=planned,
+        toolpath=None if rotary else planned,  # the rotary plan lives in its program (G93 text, figures)
         gcode=program,
         timings=timings,
         stage_findings=tuple(later),
+        positive=positive,
+        fea=fea_result,
     )
+
+
+def _fea_check(design: Design, cam: Cam, dynamics: Any) -> Any:
+    """The finite-element check with the design's ``[fea]`` table (its defaults when absent)."""
+    from camcad.fea import FeaSpec, analyse_fea
+    from camcad.geometry.spec import CamStyle
+
+    if design.cam.style is not CamStyle.PLATE:
+        style = design.cam.style.value
+        raise UsageError("fea", f"the finite-element check applies to cam.style = 'plate' only, not {style}")
+    spec = design.fea if design.fea is not None else FeaSpec()
+    return analyse_fea(cam, design.plate(), setup=design.dynamics_setup(), dynamics=dynamics, spec=spec)
 
 
 _STAGE_LIMITS: dict[str, tuple[type[DesignLimitError], str, str]] = {
@@ -275,23 +337,45 @@ def build(
         a soft one (pressure angle, contact stress, follower jump).
     """
     groups = _groups(only)
+    if only is None and design.fea is None:
+        groups.discard("fea")  # slower than everything else: by default only when the design asks for it
+    notes = _step_missing(groups, asked=only is not None)
     outdir = Path(outdir)
     with staged_folder(outdir) as staging:
-        analysis = analyse(design, fit=True, toolpath="gcode" in groups, progress=progress)
+        analysis = analyse(
+            design, fit=True, toolpath="gcode" in groups, progress=progress, fea="fea" in groups
+        )
         soft = [f for f in analysis.findings if not f.hard]
         if strict and soft:
             listed = "; ".join(f"{f.field}: {f.message}" for f in soft)
             raise DesignLimitError(f"--strict: {len(soft)} soft limit(s) broken: {listed}")
         written = _write_outputs(analysis, staging.path, groups=groups, progress=progress)
         written.append(write_json(staging.path / "summary.json", analysis.summary()))
-    return BuildResult(analysis=analysis, outdir=outdir, files=tuple(outdir / Path(p).name for p in written))
+    return BuildResult(
+        analysis=analysis, outdir=outdir, files=tuple(outdir / Path(p).name for p in written), notes=notes
+    )
+
+
+def _step_missing(groups: set[str], *, asked: bool) -> tuple[str, ...]:
+    """Without OpenCASCADE: drop ``step`` from ``groups`` and say why; refuse when ``--only`` asks for it."""
+    if "step" not in groups:
+        return ()
+    from camcad.export.step import ocp_missing
+
+    missing = ocp_missing()
+    if missing is None:
+        return ()
+    if asked:
+        raise UsageError("--only", f"step: {missing}")
+    groups.discard("step")
+    return (missing,)
 
 
 def _write_outputs(
     analysis: Analysis, folder: Path, *, groups: set[str], progress: Progress | None
 ) -> list[Path]:
     """Write the selected output groups into ``folder``; return the paths written."""
-    design, cam, timings = analysis.design, analysis.cam, analysis.timings
+    design, timings = analysis.design, analysis.timings
     plate = design.plate()
     written: list[Path] = []
 
@@ -302,37 +386,105 @@ def _write_outputs(
     if "tables" in groups:
         stage("tables", lambda: write_tables(analysis, folder))
     if "dxf" in groups:
-        from camcad.export.dxf import write_profile_dxf, write_profile_poly_dxf
+        from camcad.export.dxf import write_profile_arcs_dxf, write_profile_dxf, write_profile_poly_dxf
 
-        stage(
-            "dxf",
-            lambda: [
-                write_profile_dxf(
-                    folder / "profile.dxf", cam=cam, fit=analysis.fit, plate=plate, options=design.dxf
-                ),
-                write_profile_poly_dxf(
-                    folder / "profile_poly.dxf", cam=cam, fit=analysis.fit, plate=plate, options=design.dxf
-                ),
-            ],
-        )
+        def dxf_files() -> list[Path]:
+            out = []
+            for suffix, plate_cam, fit in _plates(analysis):
+                for name, write in (
+                    ("profile", write_profile_dxf),
+                    ("profile_poly", write_profile_poly_dxf),
+                    ("profile_arcs", write_profile_arcs_dxf),
+                ):
+                    path = folder / f"{name}{suffix}.dxf"
+                    out.append(write(path, cam=plate_cam, fit=fit, plate=plate, options=design.dxf, **groove))
+            return out
+
+        groove = _groove_drawing(analysis)
+
+        stage("dxf", dxf_files)
     if "stl" in groups:
-        from camcad.export.mesh import build_solid, write_meshes
-
-        stage(
-            "mesh",
-            lambda: write_meshes(
-                folder, build_solid(analysis.fit, plate, design.mesh, cam=cam), design.mesh.formats
-            ),
-        )
+        stage("mesh", lambda: _write_solids(analysis, folder))
+    if "step" in groups:
+        stage("step", lambda: _write_steps(analysis, folder))
     if "gcode" in groups:
         assert analysis.gcode is not None  # analysed with the toolpath when G-code is asked for
-        program = analysis.gcode.text
-        stage("gcode", lambda: write_text(folder / "cam.ngc", program))
+        programs = [("cam.ngc", analysis.gcode.text)]
+        if analysis.positive.partner_gcode is not None:
+            programs.append(("cam_2.ngc", analysis.positive.partner_gcode.text))
+        stage("gcode", lambda: [write_text(folder / name, text) for name, text in programs])
+    if "fea" in groups and analysis.fea is not None:
+        from camcad.export.stress import write_stress_vtu
+
+        fea = analysis.fea
+        stage("stress", lambda: write_stress_vtu(folder / "stress.vtu", fea))
     if "report" in groups:
         from camcad.report import write_report
 
         stage("report", lambda: write_report(analysis, folder / "report.html"))
     return written
+
+
+def _plates(analysis: Analysis) -> list[tuple[str, Cam, Any]]:
+    """The plates to export: (file suffix, cam, fit); a conjugate pair's second plate gets ``_2``."""
+    out: list[tuple[str, Cam, Any]] = [("", analysis.cam, analysis.fit)]
+    positive = analysis.positive
+    if positive.partner is not None and positive.partner_fit is not None:
+        out.append(("_2", positive.partner, positive.partner_fit))
+    return out
+
+
+def _groove_drawing(analysis: Analysis) -> dict[str, Any]:
+    """The DXF writers' ``curves`` and ``blank_radius`` for a groove cam (its flanks, the blank), else {}."""
+    from camcad.export.dxf import DxfCurve
+
+    groove, flanks = analysis.positive.groove, analysis.positive.flank_fits
+    if groove is None or flanks is None:
+        return {}
+    curves = (
+        DxfCurve(layer="GROOVE_INNER", fit=flanks[0], offset=groove.inner_offset),
+        DxfCurve(layer="GROOVE_OUTER", fit=flanks[1], offset=groove.outer_offset),
+    )
+    return {"curves": curves, "blank_radius": analysis.design.cam.outer_radius}
+
+
+def _write_solids(analysis: Analysis, folder: Path) -> list[Path]:
+    """cam.stl (and the other mesh formats): the plate, the groove cam's blank, or both plates of a pair."""
+    from camcad.export.mesh import build_groove_solid, build_solid, write_meshes
+
+    design, plate, formats = analysis.design, analysis.design.plate(), analysis.design.mesh.formats
+    groove, flanks = analysis.positive.groove, analysis.positive.flank_fits
+    if groove is not None and flanks is not None:
+        assert design.cam.outer_radius is not None  # required for a groove cam
+        solid = build_groove_solid(
+            flanks,
+            plate,
+            design.mesh,
+            outer_radius=design.cam.outer_radius,
+            depth=design.groove.depth,
+            cam=analysis.cam,
+            offsets=(groove.inner_offset, groove.outer_offset),
+        )
+        return write_meshes(folder, solid, formats)
+    out: list[Path] = []
+    for suffix, plate_cam, fit in _plates(analysis):
+        solid = build_solid(fit, plate, design.mesh, cam=plate_cam)
+        out += write_meshes(folder, solid, formats, stem=f"cam{suffix}")
+    return out
+
+
+def _write_steps(analysis: Analysis, folder: Path) -> list[Path]:
+    """cam.step: the plate, the groove cam's blank with its pocket, or both plates of a pair (cam_2.step)."""
+    from camcad.export.step import groove_body, write_cam_step, write_step
+
+    design, plate = analysis.design, analysis.design.plate()
+    flanks = analysis.positive.flank_fits
+    if analysis.positive.groove is not None and flanks is not None:
+        assert design.cam.outer_radius is not None  # required for a groove cam
+        body = groove_body(flanks, plate, outer_radius=design.cam.outer_radius, depth=design.groove.depth)
+        return [write_step(folder / "cam.step", [body])]
+    plates = _plates(analysis)
+    return [write_cam_step(folder / f"cam{suffix}.step", fit=fit, plate=plate) for suffix, _, fit in plates]
 
 
 def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
@@ -385,4 +537,35 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
         dynamics_csv,
         write_points_csv(folder / "points.csv", cam, design.tables),
         write_lift_csv(folder / "lift.csv", cam, design.tables),
+        *_polar_table(analysis, folder),
+        *_drive_table(analysis, folder),
     ]
+
+
+def _drive_table(analysis: Analysis, folder: Path) -> list[Path]:
+    """cam_table.csv (the electronic cam for a servo drive) when ``[tables] cam_table_points`` is given."""
+    from camcad.export.drive import write_drive_table
+
+    options = analysis.design.tables
+    if options.cam_table_points is None:
+        return []
+    unit = analysis.cam.follower.kind.lift_unit
+    return [
+        write_drive_table(
+            folder / "cam_table.csv",
+            analysis.cam.program,
+            options.cam_table_points,
+            layout=options.cam_table_layout,
+            unit=unit,
+        )
+    ]
+
+
+def _polar_table(analysis: Analysis, folder: Path) -> list[Path]:
+    """polar.txt (wheel-centre radius per angle) when ``[tables] wheel_radius`` is given."""
+    from camcad.export.tables import write_polar_table
+
+    design = analysis.design
+    if design.tables.wheel_radius is None:
+        return []
+    return [write_polar_table(folder / "polar.txt", analysis.cam, design.tables, name=design.cam.name)]

@@ -76,7 +76,7 @@ def quintero_table() -> None:
 
 
 def oscillating_convention() -> None:
-    """Roller and flat face on an arm at φ = 0: base circle, roller/face, pivot, d, l, β0, the rise's sense."""
+    """Roller and flat face on an arm at φ = 0: base circle, roller or face, pivot, d, l, β0, rise's sense."""
     from camcad.geometry import Cam
 
     fig = Figure(figsize=(10.0, 4.8), dpi=110)

@@ -3,9 +3,10 @@
 The layers are those of the README's architecture section, bottom first::
 
     shared bottom (_typing, _version, errors, angles, extremes, findings, units)
-      < motion < geometry < dynamics < fit < toolpath < export
+      < motion < geometry < dynamics < fea < fit < toolpath < export
       < design
-      < analysis, report, _plots < pipeline < cli, __init__, __main__
+      < analysis, positive, report, report_tables, _plots < pipeline < explore
+      < cli, serve, __init__, __main__
 
 A module imports camcad code only from its own layer or below. The design
 schema (``camcad/design.py``, later ``design/``) sits above the stages: only
@@ -35,13 +36,15 @@ LAYER_ORDER: tuple[frozenset[str], ...] = (
     frozenset({"motion"}),
     frozenset({"geometry"}),
     frozenset({"dynamics"}),
+    frozenset({"fea"}),  # camcad/fea/ (issue 22): the plate's FE check, from geometry, plate and dynamics
     frozenset({"fit"}),
     frozenset({"toolpath"}),  # camcad/toolpath/ (issue 13): the arc-spline tool paths
     frozenset({"export"}),
     frozenset({"design"}),  # the schema sits above every stage
-    frozenset({"analysis", "report", "_plots"}),
+    frozenset({"analysis", "positive", "report", "report_tables", "_plots"}),
     frozenset({"pipeline"}),
-    frozenset({"cli", "__init__", "__main__"}),
+    frozenset({"explore"}),  # camcad/explore/ (issue 20): optimise, sweep, Pareto; analyses through pipeline
+    frozenset({"cli", "serve", "__init__", "__main__"}),  # serve/ (issue 19): the live designer
 )
 LAYERS: dict[str, int] = {name: rank for rank, names in enumerate(LAYER_ORDER) for name in names}
 DESIGN_READERS_FROM = LAYERS["analysis"]  # this layer and those above may import design
@@ -225,7 +228,8 @@ def test_layer_check_flags_upward_and_design_imports():
 
 
 def test_layer_order_is_the_documented_chain():
-    chain = ["motion", "geometry", "dynamics", "fit", "toolpath", "export", "design", "analysis", "pipeline"]
+    chain = ["motion", "geometry", "dynamics", "fea", "fit", "toolpath", "export", "design"]
+    chain += ["analysis", "pipeline"]
     ranks = [LAYERS[name] for name in chain]
     assert ranks == sorted(set(ranks)), "each stage sits strictly above the one before it"
     assert LAYERS["report"] == LAYERS["_plots"] == LAYERS["analysis"]

@@ -20,6 +20,7 @@ written (G-code comments, DXF text, HTML, plot labels), not here.
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import enum
 import math
@@ -32,14 +33,29 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from camcad.design.spec import DEG, CamSpec, Design, Dialect, Direction, GcodeSpec
 from camcad.dynamics.spec import DynamicsModel, DynamicsSpec
 from camcad.errors import DesignError
-from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
+from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
+from camcad.fea.spec import FeaSpec, PlaneModel
 from camcad.fit.spec import FitSpec
-from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation, arm_problem
+from camcad.geometry.spec import (
+    CamStyle,
+    ConjugateSpec,
+    FollowerKind,
+    FollowerSpec,
+    GrooveSpec,
+    Rotation,
+    arm_problem,
+)
+from camcad.motion.blend import resolve_blends
 from camcad.motion.laws import LAWS, make_law
-from camcad.motion.segments import SegmentKind, SegmentSpec
+from camcad.motion.program import MotionProgram
+from camcad.motion.segments import Boundary, SegmentKind, SegmentSpec
+from camcad.motion.table import parse_table_text, smooth_table
+from camcad.toolpath.spec import Cutter, Machine, RotaryAxis
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -191,6 +207,16 @@ _table_step = _below(
 )
 
 
+MAX_FEA_ANGLES = 36  # [fea].angles: one FE solve each
+
+
+def _fea_angles(v: tuple[float, ...]) -> str | None:
+    if len(v) > MAX_FEA_ANGLES:
+        return f"lists {len(v)} angles; allowed: at most {MAX_FEA_ANGLES} (one FE solve each)"
+    bad = [a for a in v if not 0.0 <= a <= FULL_TURN_DEG]
+    return f"has {bad[0]:g}; allowed: cam angles 0 to 360 degrees" if bad else None
+
+
 _MESH_FORMATS = ("stl", "obj", "ply", "off", "3mf", "vtu")
 
 
@@ -218,6 +244,17 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "max_pressure_angle": _Rule("float", check=_below(90.0, "degrees"), scale=DEG),
         "min_curvature_radius": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
         "sample_step_deg": _Rule("float", check=_sample_step, scale=DEG, attr="sample_step"),
+        "style": _Rule("enum", enum=CamStyle),
+        "outer_radius": _Rule("float", check=_length),
+    },
+    "groove": {
+        "depth": _Rule("float", check=_length),
+        "clearance": _Rule("float", check=_between(0.0, 10.0, " mm")),
+    },
+    "conjugate": {
+        "angle": _Rule("float", check=_between(1.0, 359.0, " degrees"), scale=DEG),
+        "roller_radius": _Rule("float", check=_length),
+        "single_plate": _Rule("bool"),
     },
     "follower": {
         "type": _Rule("enum", enum=FollowerKind, attr="kind"),
@@ -278,8 +315,22 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "formats": _Rule("strlist", check=_mesh_formats),
         "chord_tolerance": _Rule("float", check=_chord_tolerance),
     },
+    "fea": {
+        "angles": _Rule("floatlist", check=_fea_angles, scale=DEG),
+        "plane": _Rule("enum", enum=PlaneModel),
+        "allowable_stress": _Rule("float", check=_modulus),
+        "mesh_size": _Rule("float", check=_length),
+        "contact_divisions": _Rule("int", check=_count(2, 64, "element edges across the contact strip")),
+        "growth": _Rule("float", check=_between(0.05, 1.0, " mm/mm")),
+        "keyway_fillet": _Rule("float", check=_length),
+    },
     "tables": {
         "step_deg": _Rule("float", check=_table_step, scale=DEG, attr="step"),
+        "wheel_radius": _Rule("float", check=_length_or_zero),
+        "polar_step_deg": _Rule("float", check=_table_step, scale=DEG, attr="polar_step"),
+        "polar_decimals": _Rule("int", check=_count(1, 8, "decimals of the radius in polar.txt")),
+        "cam_table_points": _Rule("int", check=_count(2, 36_000, "master steps per turn in cam_table.csv")),
+        "cam_table_layout": _Rule("enum", enum=DriveLayout),
     },
     "gcode": {
         "tool_diameter": _Rule("float", check=_length),
@@ -302,6 +353,10 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "spindle_rpm": _Rule("float", check=_between(1.0, MAX_SPEED_RPM, " rpm")),
         "coolant": _Rule("bool"),
         "mill_bore": _Rule("bool"),
+        "machine": _Rule("enum", enum=Machine),
+        "rotary_axis": _Rule("enum", enum=RotaryAxis),
+        "rotary_direction": _Rule("enum", enum=Rotation),
+        "cutter": _Rule("enum", enum=Cutter),
     },
 }
 
@@ -314,6 +369,8 @@ _SPEC_CLASSES: dict[str, type] = {
     "mesh": MeshSpec,
     "tables": TablesSpec,
     "gcode": GcodeSpec,
+    "groove": GrooveSpec,
+    "conjugate": ConjugateSpec,
 }
 
 _MOTION_KEYS = ("kind", "angle", "lift", "law")
@@ -371,6 +428,12 @@ def _to_strlist(path: str, rule: _Rule, value: Any) -> tuple[str, ...]:
     return tuple(v.lower() for v in value)
 
 
+def _to_floatlist(path: str, rule: _Rule, value: Any) -> tuple[float, ...]:
+    if not isinstance(value, list):
+        raise DesignError(path, f"expected a list of numbers, got {_show(value)}")
+    return tuple(_to_float(f"{path}[{i}]", rule, v) for i, v in enumerate(value))
+
+
 def _to_enum(path: str, rule: _Rule, value: Any) -> enum.Enum:
     assert rule.enum is not None
     allowed = [m.value for m in rule.enum]
@@ -388,6 +451,7 @@ _CONVERTERS: dict[str, Callable[[str, _Rule, Any], Any]] = {
     "bool": _to_bool,
     "str": _to_str,
     "strlist": _to_strlist,
+    "floatlist": _to_floatlist,
     "enum": _to_enum,
 }
 
@@ -399,6 +463,8 @@ def _convert(path: str, rule: _Rule, value: Any) -> Any:
         problem = rule.check(out)
         if problem:
             raise DesignError(path, f"{_show(value)} {problem}")
+    if rule.kind == "floatlist":
+        out = tuple(v * rule.scale for v in out)
     if rule.kind == "float":
         out *= rule.scale
     return out
@@ -422,14 +488,20 @@ def _section(name: str, table: Any) -> dict[str, Any]:
     return kwargs
 
 
-def _segment(index: int, table: Any) -> SegmentSpec:
+def _segment(index: int, table: Any, *, omega: float = 0.0, folder: Path | None = None) -> SegmentSpec:
+    """One ``[[motion]]`` table.
+
+    ``omega`` [rad/s] turns a ``velocity`` into a lift; ``folder`` is where a table's file is looked for.
+    """
     path = f"motion[{index}]"
     if not isinstance(table, Mapping):
         raise DesignError(path, f"expected a table, got {_show(table)}")
     kind_value = table.get("kind")
     if kind_value is None:
-        raise DesignError(f"{path}.kind", "is required (allowed: rise, return, dwell)")
+        raise DesignError(f"{path}.kind", "is required (allowed: rise, return, dwell, table)")
     kind = _convert(f"{path}.kind", _Rule("enum", enum=SegmentKind), kind_value)
+    if kind is SegmentKind.TABLE or table.get("law") == "table":
+        return _table_segment(path, kind, table, folder)
     if "angle" not in table:
         raise DesignError(
             f"{path}.angle",
@@ -441,12 +513,8 @@ def _segment(index: int, table: Any) -> SegmentSpec:
             if key not in ("kind", "angle"):
                 raise DesignError(f"{path}.{_key(key)}", _suggest(key, ["kind", "angle"]) + " for a dwell")
         return SegmentSpec(kind=kind, span=span * DEG)
-    law_params = {k: v for k, v in table.items() if k not in _MOTION_KEYS}
-    if "lift" not in table:
-        raise DesignError(
-            f"{path}.lift", f"is required for a {kind.value} (mm, {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g})"
-        )
-    lift = _convert(f"{path}.lift", _Rule("float", check=_length), table["lift"])
+    law_params = {k: v for k, v in table.items() if k not in (*_MOTION_KEYS, *_BLEND_KEYS)}
+    lift = _segment_lift(path, kind, table, span * DEG, omega)
     law_name = table.get("law")
     if law_name is None:
         raise DesignError(f"{path}.law", f"is required for a {kind.value} (allowed: {', '.join(LAWS)})")
@@ -454,9 +522,20 @@ def _segment(index: int, table: Any) -> SegmentSpec:
         raise DesignError(f"{path}.law", f"expected a law name, got {_show(law_name)}")
     if law_name in LAWS:
         allowed_keys = list(_MOTION_KEYS) + [p.name for p in LAWS[law_name].parameters]
-        for key in law_params:
+        if law_name in _ADAPTIVE_LAWS:
+            allowed_keys += list(_BLEND_KEYS)
+        if law_name == "constant-velocity":
+            allowed_keys.append("velocity")
+        for key in [*law_params, *(k for k in _BLEND_KEYS if k in table)]:
+            if key in _BLEND_KEYS and key not in allowed_keys:
+                raise DesignError(
+                    f"{path}.{key}",
+                    f"a {law_name!r} segment has its own boundary values; only law = 'polynomial' or "
+                    "'inclined-sine' can meet given ones",
+                )
             if key not in allowed_keys:
                 raise DesignError(f"{path}.{_key(key)}", _suggest(key, allowed_keys))
+        law_params.pop("velocity", None)
         for p in LAWS[law_name].parameters:
             value = law_params.get(p.name)
             if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2**53:
@@ -465,7 +544,121 @@ def _segment(index: int, table: Any) -> SegmentSpec:
         law = make_law(law_name, **law_params)
     except DesignError as err:
         raise DesignError(f"{path}.{err.path}", err.message) from None
-    return SegmentSpec(kind=kind, span=span * DEG, lift=lift, law=law)
+    start, end = (_boundary(f"{path}.{name}", table.get(name)) for name in _BLEND_KEYS)
+    return SegmentSpec(kind=kind, span=span * DEG, lift=lift, law=law, start=start, end=end)
+
+
+_BLEND_KEYS = ("start", "end")
+_ADAPTIVE_LAWS = ("polynomial", "inclined-sine")
+_CLOSE = "close"  # lift = "close": whatever brings the follower back to where the turn started
+_TABLE_KEYS = ("kind", "angle", "law", "file", "noise")
+
+
+def _segment_lift(path: str, kind: SegmentKind, table: Mapping[str, Any], span: float, omega: float) -> float:
+    """The lift of a rise or return: given, ``"close"`` (NaN until summed) or from ``velocity``."""
+    if "velocity" in table:
+        if "lift" in table:
+            raise DesignError(f"{path}.velocity", "give lift or velocity, not both")
+        if table.get("law") != "constant-velocity":
+            raise DesignError(f"{path}.velocity", "applies to law = 'constant-velocity' only")
+        speed = _convert(
+            f"{path}.velocity", _Rule("float", check=_between(1e-6, 1e7, " per second")), table["velocity"]
+        )
+        lift = speed / omega * span  # mm/s ÷ rad/s = mm/rad, × the span in rad
+        if not MIN_LENGTH_MM <= lift <= MAX_LENGTH_MM:
+            raise DesignError(
+                f"{path}.velocity",
+                f"{speed:g} per second over {span / DEG:g}° at cam.speed_rpm gives a lift of {lift:g}; "
+                f"allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g}",
+            )
+        return lift
+    if "lift" not in table:
+        raise DesignError(
+            f"{path}.lift",
+            f'is required for a {kind.value} (mm, {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g}, or "{_CLOSE}")',
+        )
+    if table["lift"] == _CLOSE:
+        return math.nan
+    return float(_convert(f"{path}.lift", _Rule("float", check=_length), table["lift"]))
+
+
+def _boundary(path: str, value: Any) -> Boundary:
+    """``start``/``end`` = {v = …, a = …, j = …}: numbers (specify) or "match" (the default)."""
+    if value is None:
+        return Boundary()
+    if not isinstance(value, Mapping):
+        example = '{ v = 0.0, a = "match" }'
+        raise DesignError(path, f"expected an inline table like {example}, got {_show(value)}")
+    out: dict[str, float | None] = {}
+    for key, item in value.items():
+        if key not in ("v", "a", "j"):
+            raise DesignError(f"{path}.{_key(key)}", _suggest(key, ["v", "a", "j"]))
+        if item == "match":
+            out[key] = None
+            continue
+        if isinstance(item, str):
+            raise DesignError(f"{path}.{key}", f'{_show(item)} is not allowed; give a number or "match"')
+        out[key] = _convert(f"{path}.{key}", _Rule("float", check=_between(-1e9, 1e9)), item)
+    return Boundary(**out)
+
+
+def _table_segment(
+    path: str, kind: SegmentKind, table: Mapping[str, Any], folder: Path | None
+) -> SegmentSpec:
+    """A point table over the whole turn: kind = "table", law = "table", file, noise."""
+    if kind is not SegmentKind.TABLE:
+        raise DesignError(f"{path}.kind", f"a point table is kind = 'table', not {kind.value!r}")
+    for key in table:
+        if key not in _TABLE_KEYS:
+            raise DesignError(f"{path}.{_key(key)}", _suggest(key, list(_TABLE_KEYS)) + " for a point table")
+    if table.get("law", "table") != "table":
+        raise DesignError(f"{path}.law", f"{_show(table['law'])}: a kind = 'table' segment has law = 'table'")
+    if "angle" in table:
+        angle = _convert(f"{path}.angle", _Rule("float"), table["angle"])
+        if angle != FULL_TURN_DEG:
+            raise DesignError(f"{path}.angle", f"{angle:g}: a point table covers the whole turn (360)")
+    for key in ("file", "noise"):
+        if key not in table:
+            what = "the CSV of angle [°], lift[, velocity]"
+            what = what if key == "file" else "the measurement noise σ (mm)"
+            raise DesignError(f"{path}.{key}", f"is required for a point table ({what})")
+    name = _convert(f"{path}.file", _Rule("str"), table["file"])
+    noise = _convert(f"{path}.noise", _Rule("float", check=_between(1e-6, 10.0, " mm")), table["noise"])
+    file = (folder or Path.cwd()) / name
+    try:
+        text = file.read_text(encoding="utf-8-sig")
+    except (OSError, ValueError) as err:
+        why = getattr(err, "strerror", None) or err
+        raise DesignError(f"{path}.file", f"cannot read {file}: {why}") from None
+    angle_rad, lift, velocity = parse_table_text(text, where=f"{path}.file")
+    law = smooth_table(angle_rad, lift, noise=noise, velocity=velocity, source=Path(name).name)
+    return SegmentSpec(kind=SegmentKind.TABLE, span=FULL_TURN_DEG * DEG, law=law)
+
+
+def _finish_motion(segments: tuple[SegmentSpec, ...], *, unit: str) -> tuple[SegmentSpec, ...]:
+    """A table stands alone; ``lift = "close"`` gets its value; the lift closes; blends are solved."""
+    tables = [i for i, g in enumerate(segments) if g.kind is SegmentKind.TABLE]
+    if tables and len(segments) > 1:
+        raise DesignError(
+            f"motion[{tables[0]}].kind",
+            "a point table describes the whole turn: it must be the only [[motion]]",
+        )
+    open_ = [i for i, g in enumerate(segments) if math.isnan(g.lift)]
+    if len(open_) > 1:
+        raise DesignError(f"motion[{open_[1]}].lift", f'only one segment may have lift = "{_CLOSE}"')
+    if open_:
+        i = open_[0]
+        rest = sum(g.signed_lift for k, g in enumerate(segments) if k != i)
+        lift = -rest if segments[i].kind is SegmentKind.RISE else rest
+        if not MIN_LENGTH_MM <= lift <= MAX_LENGTH_MM:
+            raise DesignError(
+                f"motion[{i}].lift",
+                f'"{_CLOSE}" would need a {segments[i].kind.value} of {lift:g}{unit}; the other segments '
+                f"{'rise' if rest > 0 else 'fall'} by {abs(rest):g}{unit} in total",
+            )
+        segments = (*segments[:i], dataclasses.replace(segments[i], lift=lift), *segments[i + 1 :])
+    _check_program(segments, unit=unit)
+    return resolve_blends(segments)
 
 
 def _check_program(segments: tuple[SegmentSpec, ...], *, unit: str = " mm") -> None:
@@ -504,10 +697,12 @@ def _check_program(segments: tuple[SegmentSpec, ...], *, unit: str = " mm") -> N
 def _check_design(design: Design) -> None:
     """The checks across fields, each naming the field to change."""
     _check_follower(design)
+    _check_style(design)
     _check_bore(design.cam)
     _check_dynamics(design)
     _check_tolerances(design)
     _check_gcode(design)
+    _check_fea(design)
 
 
 def _check_follower(design: Design) -> None:
@@ -545,8 +740,68 @@ def _lift_profile(segments: tuple[SegmentSpec, ...]) -> list[float]:
             s += seg.lift
         elif seg.kind is SegmentKind.RETURN:
             s -= seg.lift
+        elif seg.kind is SegmentKind.TABLE:
+            out.append(float(getattr(seg.law, "peak", 0.0)))  # a point table's highest lift
         out.append(s)
     return out
+
+
+def _check_style(design: Design) -> None:
+    """Groove and conjugate cams drive rollers; a groove needs its blank and fits in it."""
+    cam, fol = design.cam, design.follower
+    if cam.style is CamStyle.PLATE:
+        if cam.outer_radius is not None:
+            raise DesignError("cam.outer_radius", "applies to groove cams (cam.style = 'groove') only")
+        return
+    if not fol.kind.roller:
+        raise DesignError(
+            "cam.style", f"a {cam.style.value} cam needs a roller follower, not {fol.kind.value}"
+        )
+    if cam.style is CamStyle.GROOVE:
+        if cam.outer_radius is None:
+            raise DesignError("cam.outer_radius", "is required for a groove cam (mm, the blank's radius)")
+        if cam.outer_radius <= cam.base_radius + 2.0 * fol.roller_radius:
+            raise DesignError(
+                "cam.outer_radius",
+                f"{cam.outer_radius:g} mm leaves no room for the groove; allowed: > base_radius + 2 × "
+                f"roller_radius = {cam.base_radius + 2.0 * fol.roller_radius:g} mm",
+            )
+        if design.groove.depth >= cam.thickness:
+            raise DesignError(
+                "groove.depth",
+                f"{design.groove.depth:g} mm must be less than the blank's thickness {cam.thickness:g} mm",
+            )
+    if cam.style is CamStyle.CONJUGATE and design.conjugate.single_plate:
+        _check_constant_breadth(design)
+
+
+def _check_constant_breadth(design: Design) -> None:
+    """One plate for both rollers: a radial slide, rollers 180° apart, s(φ + 180°) = lift − s(φ)."""
+    fol, conj = design.follower, design.conjugate
+    if fol.kind is not FollowerKind.TRANSLATING_ROLLER or fol.eccentricity != 0.0:
+        raise DesignError(
+            "conjugate.single_plate", "a constant-breadth cam needs a translating roller with offset 0"
+        )
+    if abs(conj.angle - math.pi) > 1e-12:
+        raise DesignError("conjugate.angle", "a constant-breadth cam needs the rollers 180° apart")
+    if conj.roller_radius is not None and conj.roller_radius != fol.roller_radius:
+        raise DesignError(
+            "conjugate.roller_radius", "a constant-breadth cam needs both rollers of the same radius"
+        )
+    program = MotionProgram.from_segments(design.motion)
+    phi = np.union1d(program.sample_phi(math.radians(0.25)), [bp.phi for bp in program.breakpoints])
+    phi = phi[phi < math.pi]
+    lift = program.lift
+    gap = program.evaluate(phi).s + program.evaluate(phi + math.pi).s - lift
+    worst = int(np.argmax(np.abs(gap)))
+    if abs(gap[worst]) > 1e-9 * max(lift, 1.0):
+        raise DesignError(
+            "motion",
+            f"a constant-breadth cam needs s(φ + 180°) = lift − s(φ) (both rollers touch one plate), but at "
+            f"φ = {math.degrees(phi[worst]):.2f}° s(φ) + s(φ + 180°) = {gap[worst] + lift:.6g} mm, not the "
+            f"lift {lift:g} mm; only the first 180° of the program is free, the second half mirrors it "
+            "(or set conjugate.single_plate = false for two plates)",
+        )
 
 
 def _check_bore(cam: CamSpec) -> None:
@@ -624,9 +879,44 @@ def _check_tolerances(design: Design) -> None:
             )
 
 
+def _check_fea(design: Design) -> None:
+    """The FE check holds a plain plate at its bore, and its keyway fillet must fit."""
+    if design.fea is None:
+        return
+    from camcad.fea.model import keyway_fillet
+
+    if design.cam.style is not CamStyle.PLATE:
+        style = design.cam.style.value
+        raise DesignError("fea", f"the finite-element check applies to cam.style = 'plate' only, not {style}")
+    bore = design.plate().bore
+    if bore is None:
+        raise DesignError(
+            "cam.bore", "the finite-element check ([fea]) holds the plate at its bore: give cam.bore > 0"
+        )
+    if bore.has_keyway:
+        keyway_fillet(design.fea, bore)
+
+
 def _check_gcode(design: Design) -> None:
     cam = design.cam
     gc = design.gcode
+    if gc.machine is Machine.ROTARY and gc.dialect is Dialect.GRBL:
+        raise DesignError(
+            "gcode.dialect",
+            "'grbl' cannot run a rotary program (no rotary axis, no G93 inverse-time feed); "
+            "allowed with machine = 'rotary': linuxcnc, generic",
+        )
+    if gc.machine is Machine.ROTARY and cam.style is not CamStyle.PLATE:
+        raise DesignError(
+            "gcode.machine", f"'rotary' cuts a plate cam's outline, not a {cam.style.value} cam (allowed: xy)"
+        )
+    if gc.machine is Machine.XY and gc.cutter is Cutter.WHEEL:
+        raise DesignError("gcode.cutter", "'wheel' applies to machine = 'rotary' only (allowed: end-mill)")
+    if gc.machine is Machine.ROTARY and (gc.tab_count > 0 or gc.mill_bore):
+        field = "gcode.tab_count" if gc.tab_count > 0 else "gcode.mill_bore"
+        raise DesignError(
+            field, "the rotary program cuts the profile only: no tabs, no bore (allowed: 0 and false)"
+        )
     if gc.safe_height >= gc.clearance_height:
         raise DesignError(
             "gcode.safe_height",
@@ -722,6 +1012,11 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
     specs: dict[str, Any] = {}
     for name, cls in _SPEC_CLASSES.items():
         specs[name] = cls(**_section(name, data.get(name, {})))
+    if "fea" in data:  # present or not decides whether a build runs the FE check
+        specs["fea"] = FeaSpec(**_section("fea", data["fea"]))
+    for table in ("groove", "conjugate"):  # after their values, so a bad value names its own key
+        if table in data and specs["cam"].style.value != table:
+            raise DesignError(table, f"the [{table}] table applies to cam.style = '{table}' only")
     follower = specs["follower"]
     _check_follower_keys(follower.kind, data.get("follower", {}), data.get("dynamics", {}))
     raw_motion = data.get("motion")
@@ -731,8 +1026,10 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
         raise DesignError(
             "motion", f"{len(raw_motion)} segments; allowed: at most {MAX_SEGMENTS} [[motion]] tables"
         )
-    motion = tuple(_segment(i, seg) for i, seg in enumerate(raw_motion))
-    _check_program(motion, unit="°" if follower.kind.oscillating else " mm")
+    folder = Path(source).parent if source else None
+    omega = specs["cam"].omega
+    motion = tuple(_segment(i, seg, omega=omega, folder=folder) for i, seg in enumerate(raw_motion))
+    motion = _finish_motion(motion, unit="°" if follower.kind.oscillating else " mm")
     design = Design(motion=motion, source=source, **specs)
     _check_design(design)
     return design

@@ -16,11 +16,12 @@ from dataclasses import dataclass, field, replace
 
 from camcad.dynamics.spec import DynamicsSetup, DynamicsSpec
 from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
+from camcad.fea.spec import FeaSpec
 from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import follower_from_spec
 from camcad.geometry.followers import OscillatingFlat, OscillatingRoller
 from camcad.geometry.plate import BoreOutline, Plate
-from camcad.geometry.spec import FollowerSpec, Rotation
+from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
 from camcad.motion.segments import SegmentSpec
 from camcad.toolpath.spec import Dialect, Direction, GcodeSpec
 
@@ -44,6 +45,8 @@ class CamSpec:
     max_pressure_angle: float = 30.0 * DEG
     min_curvature_radius: float | None = None  # mm; None: 0 for roller, 1 mm for flat
     sample_step: float = 0.1 * DEG
+    style: CamStyle = CamStyle.PLATE
+    outer_radius: float | None = None  # mm, a groove cam's blank
 
     @property
     def omega(self) -> float:
@@ -64,6 +67,9 @@ class Design:
     mesh: MeshSpec = field(default_factory=MeshSpec)
     tables: TablesSpec = field(default_factory=TablesSpec)
     gcode: GcodeSpec = field(default_factory=GcodeSpec)
+    groove: GrooveSpec = field(default_factory=GrooveSpec)
+    conjugate: ConjugateSpec = field(default_factory=ConjugateSpec)
+    fea: FeaSpec | None = None  # the [fea] table: None when absent (the FE check then runs only on request)
     source: str = ""
 
     def plate(self) -> Plate:
@@ -88,6 +94,8 @@ class Design:
             # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
             tappet_offset=fol.eccentricity if cam.rotation is Rotation.CCW else -fol.eccentricity,
             arm_angle=_arm_direction(fol, cam.base_radius),
+            positive_drive=cam.style is not CamStyle.PLATE,
+            clearance=self.groove.clearance if cam.style is CamStyle.GROOVE else 0.0,
         )
 
     def with_base_radius(self, base_radius: float) -> Design:

@@ -110,7 +110,9 @@ def test_build_writes_every_file_with_the_documented_columns(tmp_path, capsys):
     assert names == {
         "profile.dxf",
         "profile_poly.dxf",
+        "profile_arcs.dxf",
         "cam.stl",
+        "cam.step",
         "cam.ngc",
         "points.csv",
         "lift.csv",
@@ -152,7 +154,12 @@ def test_only_limits_the_outputs(tmp_path):
         )
         == 0
     )
-    assert {p.name for p in out.iterdir()} == {"profile.dxf", "profile_poly.dxf", "summary.json"}
+    assert {p.name for p in out.iterdir()} == {
+        "profile.dxf",
+        "profile_poly.dxf",
+        "profile_arcs.dxf",
+        "summary.json",
+    }
     assert (
         main(
             ["build", str(ROOT / "samples" / "quintero_harmonic.toml"), "-o", str(out), "-q", "--only", "pdf"]

@@ -190,6 +190,7 @@ def test_a_failed_build_into_new_nested_folders_creates_none_of_them(tmp_path, c
     assert {p.name for p in (tmp_path / "a" / "b" / "c" / "d").iterdir()} == {
         "profile.dxf",
         "profile_poly.dxf",
+        "profile_arcs.dxf",
         "summary.json",
     }
 
@@ -403,7 +404,7 @@ def test_two_builds_are_byte_identical_whatever_the_hash_seed(tmp_path):
         runs = list(pool.map(run, zip(outs, ["1", "4"], strict=True)))
     assert [r.returncode for r in runs] == [0, 0], [r.stderr for r in runs]
     one, two = files(outs[0]), files(outs[1])
-    assert len(one) == 11
+    assert len(one) == 13  # the 11 of issue 8, profile_arcs.dxf and cam.step (issue 17)
     assert one.keys() == two.keys()
     assert [name for name in one if one[name] != two[name]] == []
     assert b"Timings" not in one["report.html"]
