@@ -11,10 +11,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camcad.design import parse_design
+from camcad.design.toml_text import toml_text
 from camcad.errors import UsageError
 from camcad.explore.pareto import pareto_mask
 from camcad.explore.space import apply_values, grid_points, lhs_points, parse_variable
-from camcad.design.toml_text import toml_text
 from tests.conftest import SAMPLES
 from tests.explore.cases import sample_data
 

@@ -12,11 +12,11 @@ import pytest
 
 from camcad.cli import main
 from camcad.design import load_design
+from camcad.design.toml_text import toml_text
 from camcad.explore.measures import MEASURES, parse_limit
 from camcad.explore.pareto import pareto_mask
 from camcad.explore.space import apply_values, grid_points, parse_variable
 from camcad.explore.sweep import SweepPlan, sweep
-from camcad.design.toml_text import toml_text
 from camcad.pipeline import analyse
 from tests.conftest import ROOT
 from tests.explore.cases import sample_data
