@@ -135,9 +135,12 @@ async function post(url, body) {
   return fetch(url, {method: "POST", headers: {"Content-Type": "application/json"}, body: JSON.stringify(body)});
 }
 
+let notes = 0;  // counts save and build messages: an analysis that began before one does not overwrite it
+
 async function analyse() {
   waiting = false;
   const id = ++sent;
+  const notesBefore = notes;
   settle();
   status.textContent = "analysing…";
   const started = performance.now();
@@ -148,7 +151,9 @@ async function analyse() {
   drawn = id;
   document.body.dataset.revision = String(id);
   settle();
-  status.textContent = (out.ok ? "updated" : "invalid input") + " in " + Math.round(performance.now() - started) + " ms";
+  if (notes === notesBefore) {
+    status.textContent = (out.ok ? "updated" : "invalid input") + " in " + Math.round(performance.now() - started) + " ms";
+  }
 }
 
 function later(ms) { clearTimeout(timer); waiting = true; settle(); timer = setTimeout(analyse, ms); }
@@ -158,16 +163,21 @@ form.addEventListener("submit", ev => ev.preventDefault());
 document.getElementById("save").addEventListener("click", async () => {
   const out = await (await post("/api/save", {values: values()})).json();
   if (out.errors) showErrors(out.errors);
+  notes++;
   status.textContent = out.saved ? "saved " + out.saved : "not saved: fix the fields marked";
 });
 document.getElementById("build").addEventListener("click", async () => {
+  notes++;
   status.textContent = "building the shop files…";
   const response = await post("/api/build", {values: values()});
-  if (!response.ok) { const out = await response.json(); showErrors(out.errors); status.textContent = "not built"; return; }
+  if (!response.ok) {
+    const out = await response.json(); showErrors(out.errors); notes++; status.textContent = "not built"; return;
+  }
   const blob = await response.blob();
   const link = document.createElement("a");
   link.href = URL.createObjectURL(blob); link.download = document.body.dataset.stem + "-shop-files.zip";
   document.body.appendChild(link); link.click(); link.remove();
+  notes++;
   status.textContent = "built: " + link.download;
 });
 analyse();
