@@ -32,7 +32,7 @@ PACKAGE = ROOT / "camcad"
 
 # Layer of each top-level name under camcad/ (a module or a package), bottom first.
 LAYER_ORDER: tuple[frozenset[str], ...] = (
-    frozenset({"_typing", "_version", "errors", "angles", "extremes", "findings", "units"}),
+    frozenset({"_typing", "_version", "_lazy", "errors", "angles", "extremes", "findings", "units"}),
     frozenset({"motion"}),
     frozenset({"geometry"}),
     frozenset({"dynamics"}),

@@ -27,6 +27,7 @@ STRICT_TYPED = (
     "camcad/angles.py",
     "camcad/errors.py",
     "camcad/_typing.py",
+    "camcad/_lazy.py",
 )
 
 

@@ -7,8 +7,9 @@ fields are written by :mod:`camcad.export.stress`.
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from camcad._lazy import lazy_names
 
 if TYPE_CHECKING:
     from camcad.fea.model import analyse_fea, load_cases, mesh_plate, plane_model
@@ -31,12 +32,7 @@ _HOME = {
 ``camcad.design`` for every design) does not load the solver and its libraries."""
 
 
-def __getattr__(name: str) -> object:
-    """Import a public name's module on first use (PEP 562)."""
-    if name in _HOME:
-        return getattr(importlib.import_module(_HOME[name]), name)
-    raise AttributeError(f"module 'camcad.fea' has no attribute {name!r}")
-
+__getattr__ = lazy_names(__name__, _HOME)
 
 __all__ = [
     "FeaResult",

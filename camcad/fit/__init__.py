@@ -11,8 +11,9 @@ curve for export.
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from camcad._lazy import lazy_names
 
 if TYPE_CHECKING:
     from camcad.fit._profile import fit_points, fit_profile
@@ -34,12 +35,7 @@ _HOME = {
 ``camcad.design``) does not load SciPy."""
 
 
-def __getattr__(name: str) -> object:
-    """Import a public name's module on first use (PEP 562)."""
-    if name in _HOME:
-        return getattr(importlib.import_module(_HOME[name]), name)
-    raise AttributeError(f"module 'camcad.fit' has no attribute {name!r}")
-
+__getattr__ = lazy_names(__name__, _HOME)
 
 __all__ = [
     "BSplineCurve",

@@ -32,8 +32,9 @@ True
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from camcad._lazy import lazy_names
 
 if TYPE_CHECKING:
     from camcad.toolpath.arcs import Pieces, biarc_pieces, fit_arc_spline, measure_deviation
@@ -58,12 +59,7 @@ _HOME = {
 ``camcad.design`` for every design) loads neither the planner nor the verifier (SciPy)."""
 
 
-def __getattr__(name: str) -> object:
-    """Import a public name's module on first use (PEP 562)."""
-    if name in _HOME:
-        return getattr(importlib.import_module(_HOME[name]), name)
-    raise AttributeError(f"module 'camcad.toolpath' has no attribute {name!r}")
-
+__getattr__ = lazy_names(__name__, _HOME)
 
 __all__ = [
     "RAPID_RATE",
