@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from camcad.explore.measures import Measure
 
 if TYPE_CHECKING:
-    from camcad.explore.sweep import SweepPlan
+    from camcad.explore.plan import SweepPlan
 
 __all__ = ["sweep_page"]
 

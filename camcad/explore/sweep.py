@@ -28,7 +28,6 @@ camcad must be installed on its workers).
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import json
 import math
 import shutil
@@ -40,10 +39,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from camcad._version import __version__
 from camcad.errors import CamcadError, OutputError, UsageError
 from camcad.explore.measures import Limit, Measure, analysis_row, failed_row
 from camcad.explore.pareto import pareto_mask
+from camcad.explore.plan import Chunk, SweepPlan
 from camcad.explore.space import Variable, design_with
 from camcad.explore.table import csv_text, parquet_bytes
 
@@ -58,77 +57,12 @@ __all__ = [
 ]
 
 FORMATS = ("parquet", "csv")
-DEFAULT_CHUNK = 16
-"""Designs per chunk: a few seconds of work for one worker (one analysis takes 30–100 ms)."""
 
 SCHEDULER_TIMEOUT_S = 20
 """How long ``--scheduler`` waits to connect before giving up [s]."""
 
 Progress = Callable[[int, int], None]
 """Called with (chunks done, chunks in all) as chunks finish, resumed ones first."""
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class SweepPlan:
-    """Everything that decides a sweep's rows.
-
-    ``data`` is the base design's TOML mapping, ``points`` one tuple of
-    values (one per variable) per design, ``limits`` extra limits judged in
-    the ``feasible`` column, ``pareto`` the two objectives of the front
-    (both minimised), ``sampling`` a short description for the page.
-    """
-
-    data: Mapping[str, Any]
-    source: str = ""
-    variables: tuple[Variable, ...]
-    points: tuple[tuple[Any, ...], ...]
-    limits: tuple[Limit, ...] = ()
-    pareto: tuple[Measure, Measure]
-    sampling: str = "grid"
-    chunk_size: int = DEFAULT_CHUNK
-
-    def key(self) -> str:
-        """A hash of everything that decides the rows (and of camcad's version)."""
-        blob = json.dumps(
-            {
-                "camcad": __version__,
-                "data": self.data,
-                "variables": [(v.name, v.path) for v in self.variables],
-                "points": [[repr(x) for x in p] for p in self.points],
-                "limits": [lim.text for lim in self.limits],
-                "chunk": self.chunk_size,
-            },
-            sort_keys=True,
-            default=repr,
-        )
-        return hashlib.sha256(blob.encode("utf-8")).hexdigest()
-
-    def chunks(self) -> list[Chunk]:
-        """The work in order: chunk k holds designs k·chunk_size … (k+1)·chunk_size − 1."""
-        n = self.chunk_size
-        return [
-            Chunk(
-                data=self.data,
-                source=self.source,
-                variables=self.variables,
-                limits=self.limits,
-                start=start,
-                points=self.points[start : start + n],
-            )
-            for start in range(0, len(self.points), n)
-        ]
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Chunk:
-    """One unit of work for a worker: designs ``start`` … ``start + len(points) − 1``."""
-
-    data: Mapping[str, Any]
-    source: str
-    variables: tuple[Variable, ...]
-    limits: tuple[Limit, ...]
-    start: int
-    points: tuple[tuple[Any, ...], ...]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
