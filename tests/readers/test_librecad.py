@@ -69,23 +69,7 @@ def paths_by_colour(pdf: Path) -> dict[str, list[np.ndarray]]:
 
 def strokes_by_colour(pdf: Path) -> dict[str, np.ndarray]:
     """Points of the stroked paths in a PDF, grouped by stroke colour (``SCN`` operands)."""
-    data = pdf.read_bytes()
-    points: dict[str, list[tuple[float, float]]] = {}
-    for raw in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, re.S):
-        try:
-            content = zlib.decompress(raw).decode("latin-1")
-        except zlib.error:
-            content = raw.decode("latin-1")
-        colour = ""
-        for line in content.splitlines():
-            found = re.fullmatch(r"([\d.]+ [\d.]+ [\d.]+) SCN", line.strip())
-            if found:
-                colour = found.group(1)
-                continue
-            found = re.fullmatch(r"(-?[\d.]+) (-?[\d.]+) [ml]", line.strip())
-            if found:
-                points.setdefault(colour, []).append((float(found.group(1)), float(found.group(2))))
-    return {k: np.asarray(v) for k, v in points.items()}
+    return {k: np.vstack(v) for k, v in paths_by_colour(pdf).items()}
 
 
 @pytest.mark.parametrize("which", ["dxf", "poly_dxf", "arcs_dxf"])

@@ -21,8 +21,6 @@ from __future__ import annotations
 
 import math
 import re
-import shutil
-import subprocess
 from dataclasses import replace
 from pathlib import Path
 
@@ -36,8 +34,8 @@ from camcad.geometry.cam import Cam
 from camcad.toolpath.rotary import plan_rotary
 from camcad.toolpath.spec import Dialect, Machine
 from tests.conftest import SAMPLES, distance_to_polygon, make_design
+from tests.readers.test_rs274 import RS274, errors, run_rs274
 
-RS274 = shutil.which("rs274")
 pytestmark = [
     pytest.mark.slow,
     pytest.mark.skipif(
@@ -47,25 +45,6 @@ pytestmark = [
 
 _CALL = re.compile(r"([A-Z_]+)\((.*)\)")
 DENSE = 60_000
-
-
-def run_rs274(text: str, folder: Path, tool: int = 1) -> tuple[subprocess.CompletedProcess[str], str]:
-    program, out, tools = folder / "cam.ngc", folder / "canon.txt", folder / "tools.tbl"
-    program.write_text(text, encoding="ascii")
-    tools.write_text(f"T{tool} P{tool} Z0 D0.25 ;camcad test tool\n", encoding="ascii")
-    proc = subprocess.run(
-        [RS274, "-t", str(tools), "-g", str(program), str(out)],
-        stdin=subprocess.DEVNULL,
-        capture_output=True,
-        text=True,
-        timeout=60,
-        check=False,
-    )
-    return proc, out.read_text(encoding="ascii") if out.exists() else ""
-
-
-def errors(proc: subprocess.CompletedProcess[str]) -> list[str]:
-    return [ln for ln in (proc.stdout + proc.stderr).splitlines() if ln.strip() and ln.strip() != "executing"]
 
 
 def canon_moves(canon: str, axis: str) -> list[dict]:
@@ -107,7 +86,7 @@ def rebuild(moves: list[dict], sign: float, spacing: float = 0.01) -> np.ndarray
 def proven(design, text: str, tmp_path: Path, *, dialect_end: str = "M2") -> list[dict]:
     """rs274 accepts the program; its G93 cut stays within tolerance of the exact curve; F gives the times."""
     spec = design.gcode
-    proc, canon = run_rs274(text, tmp_path, spec.tool_number)
+    proc, canon = run_rs274(text, spec.tool_number, tmp_path)
     assert proc.returncode == 0, errors(proc)
     assert not errors(proc)
     assert "PROGRAM_END" in canon
@@ -231,6 +210,6 @@ def test_rs274_refuses_a_g93_block_without_f(tmp_path):
     lines = plan_text(design).splitlines()
     k = next(i for i, line in enumerate(lines) if line.startswith("G1 ") and " A" in line and " F" in line)
     lines[k] = " ".join(w for w in lines[k].split() if not w.startswith("F"))
-    proc, _ = run_rs274("\n".join(lines) + "\n", tmp_path)
+    proc, _ = run_rs274("\n".join(lines) + "\n", 1, tmp_path)
     assert proc.returncode != 0
     assert any("F word missing" in line for line in errors(proc))
