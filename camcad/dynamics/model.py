@@ -343,8 +343,6 @@ def _crossovers(
     "crossover shock"; J = |d³s/dt³| [mm/s³] on a slide, |d³ψ/dt³|·r on an
     arm, r the distance from the pivot to the roller centre).
     """
-    from scipy.optimize import brentq
-
     scale = float(np.max(np.abs(force), initial=0.0))
     live = np.flatnonzero(np.abs(force) > 1e-9 * scale)
     if live.size < 2:
@@ -371,6 +369,8 @@ def _crossovers(
                 return float(model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force[0])
 
             if f(a) * f(b) < 0.0:
+                from scipy.optimize import brentq  # here: only a crossover needs it (import costs 0.3 s)
+
                 root = brentq(f, a, b, xtol=1e-12)
         root %= TWO_PI
         found.append(root)

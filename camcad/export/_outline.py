@@ -15,7 +15,6 @@ from collections.abc import Callable, Sequence
 from typing import Protocol
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 from camcad._typing import FloatArray, readonly
 from camcad.fit.curve import BSplineCurve
@@ -80,10 +79,6 @@ def _span_starts(curve: BSplineCurve) -> tuple[FloatArray, FloatArray]:
     return breaks[:-1], breaks[1:]
 
 
-def _spline(curve: BSplineCurve) -> BSpline:
-    return BSpline(curve.knots, curve.control_points, curve.degree, extrapolate=False)
-
-
 def flatten_bspline(curve: BSplineCurve, chord_tolerance: float) -> FloatArray:
     """Polyline through a non-periodic B-spline within ``chord_tolerance`` [mm].
 
@@ -119,16 +114,14 @@ def flatten_bspline(curve: BSplineCurve, chord_tolerance: float) -> FloatArray:
         raise ValueError(f"flatten_bspline supports degree ≤ 3, got {curve.degree}")
     if chord_tolerance <= 0.0:
         raise ValueError(f"chord_tolerance must be > 0, got {chord_tolerance!r}")
-    spline = _spline(curve)
-    second = spline.derivative(2) if curve.degree >= 2 else None
     start, end = _span_starts(curve)
     h = end - start
-    if second is None:
+    if curve.degree < 2:
         counts = np.ones(start.size, dtype=int)
     else:
         # C'' is linear on the span: extrapolate its end values from two interior points.
-        q1 = np.asarray(second(start + 0.25 * h))
-        q3 = np.asarray(second(start + 0.75 * h))
+        q1 = curve.evaluate(start + 0.25 * h, 2)
+        q3 = curve.evaluate(start + 0.75 * h, 2)
         at_start = 1.5 * q1 - 0.5 * q3
         at_end = 1.5 * q3 - 0.5 * q1
         bound = np.maximum(np.linalg.norm(at_start, axis=1), np.linalg.norm(at_end, axis=1))
@@ -139,10 +132,10 @@ def flatten_bspline(curve: BSplineCurve, chord_tolerance: float) -> FloatArray:
     closed = np.array_equal(curve.control_points[0], curve.control_points[-1])
     if not closed:
         params = np.append(params, end[-1])
-        points = np.asarray(spline(params[:-1]))
+        points = curve.evaluate(params[:-1])
         points = np.vstack((points, curve.control_points[-1]))
     else:
-        points = np.asarray(spline(params))
+        points = curve.evaluate(params)
     points = np.ascontiguousarray(points, dtype=float)
     readonly(points)
     return points
@@ -168,20 +161,18 @@ def bspline_area(curve: BSplineCurve) -> float:
     p-point Gauss-Legendre integrates exactly, so the result is exact up to
     round-off.
     """
-    spline = _spline(curve)
     start, end = _span_starts(curve)
     u, weight = _gauss_legendre(start, end, max(curve.degree, 1) + 1)
-    p = np.asarray(spline(u))
-    d = np.asarray(spline.derivative(1)(u))
+    p = curve.evaluate(u)
+    d = curve.evaluate(u, 1)
     return 0.5 * float(np.sum(weight * (p[:, 0] * d[:, 1] - p[:, 1] * d[:, 0])))
 
 
 def bspline_length(curve: BSplineCurve, *, nodes: int = 12) -> float:
     """Arc length of a B-spline [mm], by ``nodes``-point Gauss-Legendre on each knot span."""
-    spline = _spline(curve)
     start, end = _span_starts(curve)
     u, weight = _gauss_legendre(start, end, nodes)
-    d = np.asarray(spline.derivative(1)(u))
+    d = curve.evaluate(u, 1)
     return float(np.sum(weight * np.linalg.norm(d, axis=1)))
 
 

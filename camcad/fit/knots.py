@@ -33,8 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from camcad._typing import FloatArray, readonly
-from camcad.fit.bspline import IntArray, derivative_control_points, find_span
-from camcad.fit.curve import BSplineCurve
+from camcad.fit.curve import BSplineCurve, IntArray, derivative_control_points, find_span
 
 __all__ = [
     "GRADING",

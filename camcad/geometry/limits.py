@@ -405,8 +405,6 @@ def _reversals(cam: Cam) -> list[Finding]:
     extreme: the densest sample refined by bounded minimisation (Brent) on the
     exact motion.
     """
-    from scipy.optimize import minimize_scalar
-
     out = []
     program = cam.program
     for k, (seg, start) in enumerate(zip(program.segments, program.starts, strict=True)):
@@ -432,6 +430,8 @@ def _reversals(cam: Cam) -> list[Finding]:
 
         def forward(u: float, start: float = start, span: float = seg.span, sense: float = sense) -> float:
             return sense * float(cam.motion(np.array([start + u * span])).v[0])
+
+        from scipy.optimize import minimize_scalar  # here: only a reversal needs it (import costs 0.3 s)
 
         res = minimize_scalar(forward, bounds=(lo, hi), method="bounded", options={"xatol": 1e-12})
         phi = start + float(res.x) * seg.span

@@ -74,8 +74,27 @@ def test_derivatives_match_scipy(degree, n_knots, double):
     curve = random_periodic(np.random.default_rng(n_knots), degree, n_knots, double=double)
     u = np.linspace(-0.3, 1.3, 777)  # wraps
     ours = curve_derivatives(curve, u, 2)
+    scipy_curve = BSpline(curve.knots, curve.control_points, degree, extrapolate="periodic")
     for k in range(min(2, degree) + 1):
-        assert_allclose(ours[k], curve.evaluate(u, k), atol=1e-9 * max(1.0, np.abs(ours[k]).max()))
+        theirs = scipy_curve.derivative(k)(u) if k else scipy_curve(u)
+        assert_allclose(ours[k], theirs, atol=1e-9 * max(1.0, np.abs(ours[k]).max()))
+        assert_allclose(curve.evaluate(u, k), theirs, atol=1e-9 * max(1.0, np.abs(ours[k]).max()))
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 5])
+def test_clamped_evaluation_matches_scipy(degree):
+    """BSplineCurve.evaluate (hand-written, no scipy.interpolate) against scipy's BSpline, ends included."""
+    rng = np.random.default_rng(10 + degree)
+    knots = clamped_knot_vector(np.sort(rng.random(7)), degree)
+    ctrl = rng.normal(size=(len(knots) - degree - 1, 2))
+    curve = BSplineCurve(degree=degree, knots=knots, control_points=ctrl)
+    u = np.concatenate(([0.0, 1.0], knots[degree + 1 : -degree - 1], rng.random(199)))  # 208 values
+    spline = BSpline(knots, curve.control_points, degree)
+    for k in range(degree + 1):
+        theirs = spline.derivative(k)(u) if k else spline(u)
+        assert_allclose(curve.evaluate(u, k), theirs, rtol=1e-11, atol=1e-9)
+    assert_allclose(curve.evaluate(u.reshape(2, -1)), spline(u).reshape(2, -1, 2), atol=1e-12)
+    assert not np.any(curve.evaluate(u, degree + 1))  # beyond the degree every derivative is zero
 
 
 @pytest.mark.parametrize(("degree", "n_knots", "double"), CASES, ids=IDS)
@@ -217,3 +236,43 @@ def test_geomdl_agrees_with_a_clamped_form_opened_inside(degree, n_knots, double
     v = np.linspace(0.0, 1.0, 401)
     theirs = np.array(crv.evaluate_list(v.tolist()))
     assert_allclose(theirs, periodic.evaluate(seam + v), atol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(1, 60), w=st.integers(1, 6), cols=st.integers(1, 5), seed=st.integers(0, 2**32 - 1))
+def test_band_cholesky_solve_matches_dense_solve(n, w, cols, seed):
+    """The hand-written band Cholesky solve against numpy's dense LU solve, for any SPD band matrix."""
+    from camcad.fit.bspline import _band_cholesky, _band_solve, _solve_spd_banded
+
+    rng = np.random.default_rng(seed)
+    half = np.tril(np.triu(rng.normal(size=(n, n)), -w), 0)  # lower band factor
+    mat = half @ half.T + n * np.eye(n)  # SPD, bandwidth w
+    rhs = rng.normal(size=(n, cols))
+    dense = np.linalg.solve(mat, rhs)
+    assert_allclose(_band_solve(_band_cholesky(mat, w), rhs), dense, rtol=1e-9, atol=1e-12)
+    assert_allclose(_solve_spd_banded(mat, rhs, w), dense, rtol=1e-9, atol=1e-12)
+
+
+def test_band_cholesky_refuses_an_indefinite_matrix():
+    from camcad.fit.bspline import _band_cholesky
+
+    with pytest.raises(np.linalg.LinAlgError, match="positive definite"):
+        _band_cholesky(np.diag([1.0, -1.0, 1.0]), 1)
+
+
+def test_large_periodic_fit_takes_the_band_path_and_matches_dense_least_squares():
+    """A periodic fit beyond the dense cut-off (the band factor) against lstsq on the design matrix."""
+    from camcad.fit.bspline import _DENSE_UP_TO
+
+    k = _DENSE_UP_TO + 40
+    tau = np.arange(k) / k
+    params = (np.arange(8 * k) + 0.5) / (8 * k)
+    points = np.column_stack((np.cos(2 * np.pi * params), np.sin(6 * np.pi * params)))
+    fit = lsq_periodic(params, points, tau, 3)
+    basis = np.zeros((params.size, k))
+    for j in range(k):  # each periodic basis function as the curve of one unit control point
+        ctrl = np.zeros((k, 2))
+        ctrl[j, 0] = 1.0
+        basis[:, j] = periodic_curve(tau, ctrl, 3).evaluate(params)[:, 0]
+    expect = np.linalg.lstsq(basis, points, rcond=None)[0]
+    assert_allclose(fit.curve.control_points[:k], expect, atol=1e-9)
