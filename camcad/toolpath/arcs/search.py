@@ -180,19 +180,22 @@ def _gap(k: FloatArray, b: FloatArray, ww: FloatArray) -> FloatArray:
 def _outside(k: FloatArray, a: FloatArray, b: FloatArray, ww: FloatArray, band: float) -> np.ndarray:
     """True where a sample (w·t = a, w·n = b, |w|² = ww) is off the band of the arc or behind its start.
 
-    :func:`_gap` written with fewer temporary arrays (the screen's inner loop).
+    :func:`_gap` rearranged for the screen's inner loop: with num = k·ww − 2b,
+    the root's argument 1 − 2kb + k²ww is 1 + k·num, and |gap| > band is
+    tested as |num| > band·(1 + √(1 + k·num)) (no division, fewer temporaries).
     """
-    kb = k * b
-    den = 1.0 - 2.0 * kb
-    den += k * k * ww
-    np.maximum(den, 0.0, out=den)
-    np.sqrt(den, out=den)
-    den += 1.0
-    gap = k * ww
-    gap -= 2.0 * b
-    gap /= den
-    np.abs(gap, out=gap)
-    return (gap > band) | ~((a > 0.0) | (kb > 0.5))
+    num = k * ww
+    num -= b
+    num -= b
+    root = k * num
+    root += 1.0
+    np.maximum(root, 0.0, out=root)
+    np.sqrt(root, out=root)
+    root += 1.0
+    root *= band
+    off = np.abs(num, out=num) > root
+    off |= (a <= 0.0) & (k * b <= 0.5)
+    return off
 
 
 def _expand(
