@@ -68,8 +68,6 @@ def _cmd_build(args: argparse.Namespace) -> int:
         print(f"camcad {__version__}: building {design.cam.name!r} from {args.design}", file=sys.stderr)
     result = build(design, args.output, only=only, progress=_progress(args.quiet), strict=args.strict)
     warnings = result.analysis.warnings
-    for note in result.notes:  # an output left out (cam.step without OpenCASCADE): said even with -q
-        print(f"note: {note}", file=sys.stderr)
     if not args.quiet:
         for w in warnings:
             print(f"warning: {w}", file=sys.stderr)

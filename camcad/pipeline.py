@@ -57,7 +57,7 @@ OUTPUT_GROUPS: dict[str, tuple[str, ...]] = {
     ),
     "dxf": ("profile.dxf", "profile_poly.dxf", "profile_arcs.dxf"),
     "stl": ("cam.stl",),
-    "step": ("cam.step",),  # needs the extra camcad[step]; skipped with a note without it
+    "step": ("cam.step",),
     "gcode": ("cam.ngc",),
     "fea": ("stress.vtu",),  # the FE check (extra camcad[fea]); by default only when [fea] is present
     "report": ("report.html",),
@@ -79,7 +79,6 @@ class BuildResult:
     analysis: Analysis
     outdir: Path
     files: tuple[Path, ...]
-    notes: tuple[str, ...] = ()  # outputs left out and why (cam.step without OpenCASCADE), one line each
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -339,7 +338,6 @@ def build(
     groups = _groups(only)
     if only is None and design.fea is None:
         groups.discard("fea")  # slower than everything else: by default only when the design asks for it
-    notes = _step_missing(groups, asked=only is not None)
     outdir = Path(outdir)
     with staged_folder(outdir) as staging:
         analysis = analyse(
@@ -351,24 +349,7 @@ def build(
             raise DesignLimitError(f"--strict: {len(soft)} soft limit(s) broken: {listed}")
         written = _write_outputs(analysis, staging.path, groups=groups, progress=progress)
         written.append(write_json(staging.path / "summary.json", analysis.summary()))
-    return BuildResult(
-        analysis=analysis, outdir=outdir, files=tuple(outdir / Path(p).name for p in written), notes=notes
-    )
-
-
-def _step_missing(groups: set[str], *, asked: bool) -> tuple[str, ...]:
-    """Without OpenCASCADE: drop ``step`` from ``groups`` and say why; refuse when ``--only`` asks for it."""
-    if "step" not in groups:
-        return ()
-    from camcad.export.step import ocp_missing
-
-    missing = ocp_missing()
-    if missing is None:
-        return ()
-    if asked:
-        raise UsageError("--only", f"step: {missing}")
-    groups.discard("step")
-    return (missing,)
+    return BuildResult(analysis=analysis, outdir=outdir, files=tuple(outdir / Path(p).name for p in written))
 
 
 def _write_outputs(

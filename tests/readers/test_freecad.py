@@ -75,7 +75,6 @@ def freecad(script: str, folder: Path) -> dict:
 
 def test_freecad_reads_cam_step_as_the_exact_solid(built: Built, tmp_path):
     """Part.read: one valid solid, one shell; the fit's B-spline; areas and volume; the product name."""
-    pytest.importorskip("OCP", reason="cam.step needs the extra camcad[step]")
     from camcad.export.step import write_cam_step
 
     plate = built.design.plate()
