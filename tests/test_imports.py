@@ -47,3 +47,18 @@ def test_camcad_check_analyses_fit_and_toolpath_without_matplotlib_or_meshes():
     loaded = loaded_after(code)
     assert "camcad" in loaded
     assert not loaded & {*REPORT_ONLY, *MESH_ONLY}
+
+
+def test_a_whole_build_writes_its_meshes_without_trimesh_or_networkx(tmp_path):
+    """Every default output of a plate and a groove cam, in one fresh interpreter: the STL is written
+    (manifold3d loaded) by camcad's own writers, so trimesh, networkx and mapbox_earcut never load."""
+    builds = {name: tmp_path / name for name in ("quintero_vap_b01", "groove_rocker")}
+    code = "from camcad.cli import main\n" + "".join(
+        f"assert main(['build', {str(ROOT / 'samples' / f'{name}.toml')!r}, '-o', {str(out)!r}, '-q']) == 0\n"
+        for name, out in builds.items()
+    )
+    loaded = loaded_after(code)
+    for out in builds.values():
+        assert (out / "cam.stl").stat().st_size > 84 and (out / "report.html").is_file()
+    assert "manifold3d" in loaded
+    assert not loaded & {"trimesh", "networkx", "mapbox_earcut"}

@@ -24,6 +24,7 @@ STRICT_TYPED = (
     "camcad/fit",
     "camcad/extremes.py",
     "camcad/findings.py",
+    "camcad/roots.py",
     "camcad/angles.py",
     "camcad/errors.py",
     "camcad/_typing.py",

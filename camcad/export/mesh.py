@@ -8,12 +8,14 @@ Every build is checked, and any failure raises
 :class:`~camcad.errors.ExportError`:
 
 1. manifold3d reports no error, and the mesh is watertight with consistent
-   winding (trimesh);
+   winding: no face repeats a vertex, and every undirected edge is used by
+   exactly two faces, in opposite directions
+   (:meth:`~camcad.export._triangles.TriangleMesh.closed_defect`, numpy);
 2. the genus equals the number of holes (manifold3d, and again from the
    Euler characteristic χ = 2 − 2g of the triangle mesh);
-3. the mesh volume equals (area of the extruded polygon) × thickness to
-   1e-6 relative: this proves the triangulation and extrusion, not the
-   polygon;
+3. the mesh volume (divergence theorem, numpy) equals (area of the extruded
+   polygon) × thickness to 1e-6 relative: this proves the triangulation and
+   extrusion, not the polygon;
 4. the polygon's area (outline minus hole) agrees with the exact area
    (fitted spline's area by Green's theorem, exact for a cubic, minus the
    exact bore-and-keyway area) within tol × (spline length + hole
@@ -25,14 +27,20 @@ Every build is checked, and any failure raises
 
 Together 3-5 tie the solid's volume to the exact cam: the polygon area may
 differ from the curve area by O(chord tolerance), never more.
+
+The mesh is a small value (:class:`~camcad.export._triangles.TriangleMesh`:
+manifold3d's vertices and faces), and STL, PLY, OBJ, OFF and 3MF are written
+by hand with numpy and the standard library (``camcad/export/_triangles.py``):
+importing trimesh, with the networkx, meshio and SciPy modules it loads, took longer
+(0.3-0.6 s) than building, checking and writing the solid. Only VTU
+loads a library (meshio), and only when asked for. trimesh stays the
+independent reader in the tests.
 """
 
 from __future__ import annotations
 
-import io
 import math
 import os
-import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,7 +48,6 @@ from typing import TYPE_CHECKING
 
 import manifold3d
 import numpy as np
-import trimesh
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import ExportError
@@ -51,6 +58,14 @@ from camcad.export._outline import (
     flatten_bspline,
     oriented,
     polygon_area,
+)
+from camcad.export._triangles import (
+    TriangleMesh,
+    obj_bytes,
+    off_bytes,
+    ply_bytes,
+    stl_bytes,
+    threemf_bytes,
 )
 from camcad.export.atomic import atomic_write, atomic_write_bytes
 from camcad.export.spec import MeshSpec
@@ -65,6 +80,7 @@ __all__ = [
     "VOLUME_RTOL",
     "GrooveSolidResult",
     "SolidResult",
+    "TriangleMesh",
     "build_groove_solid",
     "build_solid",
     "threemf_bytes",
@@ -73,8 +89,6 @@ __all__ = [
 
 MESH_FORMATS = ("stl", "obj", "ply", "off", "3mf", "vtu")
 VOLUME_RTOL = 1e-6  # mesh volume vs polygon area × thickness
-# 80-byte binary STL header: says the unit, and must not begin with "solid" (ASCII STL)
-STL_HEADER = b"camcad cam plate, binary STL, units mm".ljust(80, b"\0")
 AREA_ROUNDOFF = 1e-9  # relative slack for round-off in the area comparisons
 
 
@@ -112,7 +126,7 @@ class SolidResult:
         Largest allowed |spline_area − profile_area| [mm²]; None without cam.
     """
 
-    mesh: trimesh.Trimesh
+    mesh: TriangleMesh
     volume: float
     genus: int
     holes: int
@@ -170,8 +184,8 @@ def _check_areas(
 
 def _checked_mesh(
     solid: manifold3d.Manifold, holes: int, what: str, why: str = ""
-) -> tuple[trimesh.Trimesh, int]:
-    """The manifold as a trimesh, with its genus, after checks 1-2 of the module docstring.
+) -> tuple[TriangleMesh, int]:
+    """The manifold's triangle mesh, with its genus, after checks 1-2 of the module docstring.
 
     Raises
     ------
@@ -185,14 +199,13 @@ def _checked_mesh(
     genus = int(solid.genus())
     if genus != holes:
         raise ExportError(f"solid check failed: genus {genus} but {what} has {holes} through hole(s){why}")
-    raw = solid.to_mesh64()
-    mesh = trimesh.Trimesh(
-        vertices=np.asarray(raw.vert_properties, dtype=float)[:, :3],
-        faces=np.asarray(raw.tri_verts, dtype=np.int64),
-        process=False,
-    )
-    if not (mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0.0):
-        raise ExportError(f"solid check failed: the mesh of {what} is not a closed, consistently wound solid")
+    mesh = TriangleMesh.from_manifold(solid)
+    defect = mesh.closed_defect()
+    if defect is not None or mesh.volume <= 0.0:
+        reason = defect or "its faces wind inward (volume ≤ 0)"
+        raise ExportError(
+            f"solid check failed: the mesh of {what} is not a closed, consistently wound solid: {reason}"
+        )
     return mesh, genus
 
 
@@ -281,7 +294,7 @@ class GrooveSolidResult:
         Exact blank area less the exact bore area [mm²].
     """
 
-    mesh: trimesh.Trimesh
+    mesh: TriangleMesh
     volume: float
     expected_volume: float
     genus: int
@@ -393,78 +406,24 @@ def build_groove_solid(
 # ---------------------------------------------------------------------------
 # writers
 
-_CONTENT_TYPES = (
-    '<?xml version="1.0" encoding="UTF-8"?>\n'
-    '<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">'
-    '<Default Extension="rels" '
-    'ContentType="application/vnd.openxmlformats-package.relationships+xml"/>'
-    '<Default Extension="model" '
-    'ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>'
-    "</Types>\n"
-)
-_RELS = (
-    '<?xml version="1.0" encoding="UTF-8"?>\n'
-    '<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">'
-    '<Relationship Target="/3D/3dmodel.model" Id="rel0" '
-    'Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>'
-    "</Relationships>\n"
-)
-
-
-def threemf_bytes(mesh: trimesh.Trimesh, *, name: str = "cam") -> bytes:
-    """Encode a 3MF package (core spec 1.x, unit millimetre) holding one mesh object.
-
-    Written with the standard library (zipfile), so it needs no XML package;
-    entries carry a fixed timestamp, so equal meshes give equal bytes.
-    """
-    vertices = "".join(
-        f'<vertex x="{x!r}" y="{y!r}" z="{z!r}"/>' for x, y, z in np.asarray(mesh.vertices).tolist()
-    )
-    triangles = "".join(
-        f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in np.asarray(mesh.faces).tolist()
-    )
-    safe = "".join(ch for ch in name if ch.isalnum() or ch in "-_ .") or "cam"
-    model = (
-        '<?xml version="1.0" encoding="UTF-8"?>\n'
-        '<model unit="millimeter" xml:lang="en-US" '
-        'xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02">'
-        f'<resources><object id="1" type="model" name="{safe}"><mesh>'
-        f"<vertices>{vertices}</vertices><triangles>{triangles}</triangles>"
-        '</mesh></object></resources><build><item objectid="1"/></build></model>\n'
-    )
-    buffer = io.BytesIO()
-    with zipfile.ZipFile(buffer, "w", compression=zipfile.ZIP_DEFLATED) as archive:
-        for entry, text in (
-            ("[Content_Types].xml", _CONTENT_TYPES),
-            ("_rels/.rels", _RELS),
-            ("3D/3dmodel.model", model),
-        ):
-            info = zipfile.ZipInfo(entry, date_time=(1980, 1, 1, 0, 0, 0))
-            info.compress_type = zipfile.ZIP_DEFLATED
-            archive.writestr(info, text.encode("utf-8"))
-    return buffer.getvalue()
-
-
-def _write_vtu(tmp: Path, mesh: trimesh.Trimesh) -> None:
+def _write_vtu(tmp: Path, mesh: TriangleMesh) -> None:
     import meshio  # here: only the VTU format needs it
 
     cells = [meshio.CellBlock("triangle", np.asarray(mesh.faces, dtype=np.int64))]
     meshio.write(tmp, meshio.Mesh(np.asarray(mesh.vertices, dtype=float), cells), file_format="vtu")
 
 
-def _encoded(mesh: trimesh.Trimesh, fmt: str) -> bytes:
+def _encoded(mesh: TriangleMesh, fmt: str, stem: str) -> bytes:
     if fmt == "stl":
-        data = bytes(mesh.export(file_type="stl"))  # binary STL
-        return STL_HEADER + data[len(STL_HEADER) :]
+        return stl_bytes(mesh)  # binary
     if fmt == "ply":
-        return bytes(mesh.export(file_type="ply", encoding="binary"))
+        return ply_bytes(mesh)  # binary, float64 vertices
     if fmt == "obj":
-        text = mesh.export(file_type="obj", include_normals=False, include_texture=False)
-        return str(text).encode("utf-8")
+        return obj_bytes(mesh)
     if fmt == "off":
-        return str(mesh.export(file_type="off")).encode("utf-8")
+        return off_bytes(mesh)
     if fmt == "3mf":
-        return threemf_bytes(mesh)
+        return threemf_bytes(mesh, name=stem)
     raise ValueError(fmt)
 
 
@@ -487,7 +446,7 @@ def write_meshes(
         Any of ``stl, obj, ply, off, 3mf, vtu`` (``[mesh].formats``); STL is
         written whether listed or not.
     stem
-        File name stem.
+        File name stem, also the 3MF object's name.
 
     Returns
     -------
@@ -510,6 +469,6 @@ def write_meshes(
         if fmt == "vtu":
             atomic_write(path, lambda tmp: _write_vtu(tmp, solid.mesh))
         else:
-            atomic_write_bytes(path, _encoded(solid.mesh, fmt))
+            atomic_write_bytes(path, _encoded(solid.mesh, fmt, stem))
         written.append(path)
     return written
