@@ -15,6 +15,7 @@ after a warm-up build that loads the libraries) and their ratio to the
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import time
 from typing import Any
@@ -53,7 +54,7 @@ def split(kind: str, span: float, pieces: int) -> list[dict[str, Any]]:
     marks = [0.0, *(span * where(i / pieces) for i in range(1, pieces)), span]
     return [
         {"kind": kind, "angle": hi - lo, "lift": LIFT / pieces, "law": "polynomial"}
-        for lo, hi in zip(marks, marks[1:], strict=False)
+        for lo, hi in itertools.pairwise(marks)
     ]
 
 
@@ -74,7 +75,7 @@ def stage_seconds(segments: int, repeat: int) -> dict[str, float]:
     d = design(segments)
     for _ in range(repeat):
         times: dict[str, float] = {}
-        analyse(d, progress=lambda name, seconds: times.__setitem__(name, seconds))
+        analyse(d, progress=times.__setitem__)
         for name in ("fit", "toolpath"):
             best[name] = min(best.get(name, math.inf), times[name])
     return best
@@ -95,7 +96,8 @@ def main() -> None:
     print("| segments | fit [ms] | toolpath [ms] | fit + toolpath [ms] | × the first |")
     print("|---:|---:|---:|---:|---:|")
     for n, fit, path, _ in rows:
-        print(f"| {n} | {1000 * fit:.0f} | {1000 * path:.0f} | {1000 * (fit + path):.0f} | {(fit + path) / base:.2f} |")
+        total = fit + path
+        print(f"| {n} | {1000 * fit:.0f} | {1000 * path:.0f} | {1000 * total:.0f} | {total / base:.2f} |")
 
 
 if __name__ == "__main__":

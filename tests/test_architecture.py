@@ -2,7 +2,7 @@
 
 The layers are those of the README's architecture section, bottom first::
 
-    shared bottom (_typing, _version, errors, angles, extremes, findings, units)
+    shared bottom (_typing, _version, errors, angles, extremes, findings, roots, units)
       < motion < geometry < dynamics < fea < fit < toolpath < export
       < design
       < analysis, positive, report, report_tables, _plots < pipeline < explore
@@ -32,7 +32,7 @@ PACKAGE = ROOT / "camcad"
 
 # Layer of each top-level name under camcad/ (a module or a package), bottom first.
 LAYER_ORDER: tuple[frozenset[str], ...] = (
-    frozenset({"_typing", "_version", "_lazy", "errors", "angles", "extremes", "findings", "units"}),
+    frozenset({"_typing", "_version", "_lazy", "errors", "angles", "extremes", "findings", "roots", "units"}),
     frozenset({"motion"}),
     frozenset({"geometry"}),
     frozenset({"dynamics"}),

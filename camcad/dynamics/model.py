@@ -26,6 +26,7 @@ from camcad.dynamics.spring import spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, tappet_forces
 from camcad.extremes import Extreme, Kind, Side, extremes_rows
 from camcad.findings import Finding, Severity
+from camcad.roots import brent_root
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -369,9 +370,7 @@ def _crossovers(
                 return float(model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force[0])
 
             if f(a) * f(b) < 0.0:
-                from scipy.optimize import brentq  # here: only a crossover needs it (import costs 0.3 s)
-
-                root = brentq(f, a, b, xtol=1e-12)
+                root = brent_root(f, a, b, xtol=1e-12)
         root %= TWO_PI
         found.append(root)
         if cam is not None and setup.clearance > 0.0:

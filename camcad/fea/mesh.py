@@ -53,6 +53,9 @@ class Spot:
     radius: float = 0.0
 
 
+_MERGE = 1e-6  # × a piece's parameter range: fixed nodes closer than this are merged
+
+
 def element_size(points: FloatArray, spots: Sequence[Spot], *, h_max: float, growth: float) -> FloatArray:
     """The target element size [mm] at points (n, 2): h = min(h_max, minᵢ hᵢ + g·max(0, dᵢ − rᵢ)).
 
@@ -136,9 +139,12 @@ def _sample_piece(piece: Piece, spots: Sequence[Spot], h_max: float, growth: flo
     ds = np.hypot(*np.diff(pts, axis=0).T)
     density = np.concatenate(([0.0], np.cumsum(ds * 0.5 * (1.0 / h[1:] + 1.0 / h[:-1]))))
     fixed = np.asarray(sorted(set(piece.fixed) | {piece.start, piece.stop}), dtype=float)
-    keep = np.concatenate(([True], np.diff(fixed) > 1e-12 * (piece.stop - piece.start)))
+    # nodes closer than _MERGE of the piece are one (the start and the stop stay): an edge of
+    # 1e-8 mm at 45 mm from the axis leaves skfem's inverse map no digits to converge in
+    gap = _MERGE * (piece.stop - piece.start)
+    keep = np.concatenate(([True], np.diff(fixed) > gap))
     keep[-1] = True  # the stop stays; a fixed node a hair before it goes
-    keep[-2] = keep[-2] and fixed[-1] - fixed[-2] > 1e-12 * (piece.stop - piece.start)
+    keep[-2] = keep[-2] and fixed[-1] - fixed[-2] > gap
     fixed = fixed[keep]
     nodes: list[FloatArray] = []
     for a, b in itertools.pairwise(fixed):

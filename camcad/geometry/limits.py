@@ -16,6 +16,7 @@ from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.sizing import min_base_radius
+from camcad.roots import brent_root
 
 __all__ = ["GeometryAnalysis", "Undercut", "analyse_geometry", "undercut_error"]
 
@@ -135,9 +136,7 @@ def _bad_range(quantity: Quantity, limit: float, worst: Extreme, step: float) ->
     def root(inside: float, outside: float) -> float:
         if g(outside) < 0.0:
             return outside
-        from scipy.optimize import brentq  # here: only a broken limit's range needs it
-
-        return float(brentq(g, min(inside, outside), max(inside, outside), xtol=1e-12))
+        return brent_root(g, min(inside, outside), max(inside, outside), xtol=1e-12)
 
     centre = worst.phi
     lo = centre if worst.side == "right" else root(centre - 1e-12, centre - 2.0 * step)
