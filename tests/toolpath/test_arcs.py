@@ -291,3 +291,43 @@ def test_offset_that_would_turn_an_arc_inside_out_is_refused():
     assert inner is not None
     assert_allclose(inner.r_start[~inner.line], 0.1, atol=1e-9)
     assert_allclose(inner.center.reshape(-1, 2)[~inner.line.ravel()], 0.0, atol=1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    radius=st.floats(-200.0, 200.0).filter(lambda r: abs(r) > 2.0),
+    band=st.floats(1e-4, 0.05),
+    behind=st.booleans(),
+)
+def test_the_screen_reach_is_the_first_sample_a_walk_finds_outside_the_band(seed, radius, band, behind):
+    """_admissible + _first_out (running curvature intervals, binary search) against walking every sample.
+
+    The walk measures each sample's distance to the arc from its centre, |‖q − c‖ − R| (a line: |w·n|),
+    and takes a sample behind the start (w·t ≤ 0) as outside unless it lies beyond the arc's half
+    turn (κ·(w·n) > 1/2), the screen's rule.
+    """
+    from camcad.toolpath.arcs.search import _admissible, _first_out
+
+    rng = np.random.default_rng(seed)
+    # samples along a circle of the given radius from the origin (the state), with noise of about the band
+    s = np.sort(rng.uniform(-2.0 if behind else 0.01, 30.0, 64))
+    ang = s / radius
+    pts = np.column_stack((radius * np.sin(ang), radius * (1.0 - np.cos(ang))))
+    pts += rng.normal(0.0, band, pts.shape)
+    a, b = pts[:, 0], pts[:, 1]  # the state's tangent is +x, its normal +y
+    kappa = 1.0 / radius + rng.normal(0.0, 0.02 / abs(radius), 40)
+    kappa[:3] = (0.0, 1.0 / radius, -1.0 / radius)
+    lo, hi = _admissible(a[None], b[None], (a * a + b * b)[None], band)
+    got = _first_out(np.maximum.accumulate(lo, axis=1), np.minimum.accumulate(hi, axis=1), kappa[None])[0]
+    for k, first in zip(kappa, got, strict=True):
+        if k == 0.0:
+            dist = np.abs(b)
+        else:
+            centre = np.array([0.0, 1.0 / k])
+            dist = np.abs(np.hypot(a - centre[0], b - centre[1]) - 1.0 / abs(k))
+        out = (dist > band) | ((a <= 0.0) & (k * b <= 0.5))
+        walk = int(np.argmax(out)) if out.any() else a.size
+        near_tie = np.abs(dist - band) < 1e-9 * max(1.0, float(np.max(np.abs(pts))))
+        if walk != first:  # only a sample on the band's edge (to round-off) may be judged either way
+            assert near_tie[min(walk, first)]
