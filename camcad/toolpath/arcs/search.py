@@ -181,18 +181,20 @@ def _ends(kappa: FloatArray, reach: np.ndarray, abw: FloatArray, rows: np.ndarra
     the arc's curvature, its gap [mm] there, the sample's a = w·t, b = w·n,
     and whether it is the last sample the arc reaches.
     """
-    aims = kappa.shape[1]
+    states, aims = kappa.shape
+    width = abw.shape[2]
     reach = np.where(rows[:, None], reach, -1).reshape(-1)
     first = (reach + 1) // 2
     count = np.maximum(reach - first + 1, 0)
-    arc_i = np.repeat(np.arange(reach.size), count)
     ends = np.cumsum(count)
-    w_i = np.arange(arc_i.size) + np.repeat(first - (ends - count), count)
-    last = np.zeros(arc_i.size, dtype=bool)
+    total = int(ends[-1]) if ends.size else 0
+    w_i = np.arange(total) + np.repeat(first - (ends - count), count)
+    last = np.zeros(total, dtype=bool)
     last[ends[count > 0] - 1] = True
-    s_i = arc_i // aims
-    kk = kappa.reshape(-1)[arc_i]
-    a, b, ww = abw[:, s_i, w_i]
+    s_i = np.repeat(np.repeat(np.arange(states), aims), count)
+    kk = np.repeat(kappa.reshape(-1), count)
+    flat = s_i * width + w_i
+    a, b, ww = (np.take(abw[k].reshape(-1), flat) for k in range(3))
     return s_i, w_i, kk, _gap(kk, b, ww), a, b, last
 
 
@@ -228,7 +230,10 @@ def _expand(
         turn = np.arctan2(kk * aa, 1.0 - kk * bb)
         found.append((todo[s_i], kk, jj[s_i] + 1 + w_i, off, turn, last))
         todo, width = todo[more], 2 * width
-    s_i, kk, end, off, turn, last = (np.concatenate(f) for f in zip(*found, strict=True))
+    if len(found) == 1:  # most layers: one window was enough for every state
+        s_i, kk, end, off, turn, last = found[0]
+    else:
+        s_i, kk, end, off, turn, last = (np.concatenate(f) for f in zip(*found, strict=True))
     if s_i.size == 0:
         return s_i, end, kk
     ang = angle_of(t)[s_i] + turn - tan_ang[end]
