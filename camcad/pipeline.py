@@ -9,10 +9,15 @@ the output folder only when every stage has succeeded.
 from __future__ import annotations
 
 import math
+import os
+import pickle
 import re
+import signal
+import sys
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +26,7 @@ import numpy as np
 from camcad.analysis import Analysis, motion_summary
 from camcad.design import Design, load_design
 from camcad.dynamics import analyse_dynamics
-from camcad.errors import DesignLimitError, FitError, GougeError, UsageError
+from camcad.errors import DesignLimitError, ExportError, FitError, GougeError, UsageError
 from camcad.export.atomic import staged_folder
 from camcad.export.records import write_csv, write_json, write_text
 from camcad.findings import Finding, Severity
@@ -316,6 +321,7 @@ def build(
     only: Iterable[str] | None = None,
     progress: Progress | None = None,
     strict: bool = False,
+    parallel: bool = True,
 ) -> BuildResult:
     """Analyse the design and write its files into ``outdir`` all at once.
 
@@ -323,6 +329,12 @@ def build(
     files are moved into ``outdir`` only when every stage has succeeded, so a
     failed build leaves ``outdir`` exactly as it was and nothing beside it
     (see :func:`camcad.export.atomic.staged_folder`).
+
+    With ``parallel`` (the default) on Linux with two or more CPUs, the
+    report is drawn in a forked child process while this one writes the
+    other files (:class:`_Background`): its libraries' import and its
+    drawing take about as long as all the other outputs together. The files
+    are the same bytes either way.
 
     Raises
     ------
@@ -347,15 +359,120 @@ def build(
         if strict and soft:
             listed = "; ".join(f"{f.field}: {f.message}" for f in soft)
             raise DesignLimitError(f"--strict: {len(soft)} soft limit(s) broken: {listed}")
-        written = _write_outputs(analysis, staging.path, groups=groups, progress=progress)
+        written = _write_outputs(
+            analysis, staging.path, groups=groups, progress=progress, parallel=parallel and _can_fork()
+        )
         written.append(write_json(staging.path / "summary.json", analysis.summary()))
     return BuildResult(analysis=analysis, outdir=outdir, files=tuple(outdir / Path(p).name for p in written))
 
 
 def _write_outputs(
+    analysis: Analysis, folder: Path, *, groups: set[str], progress: Progress | None, parallel: bool = False
+) -> list[Path]:
+    """Write the selected output groups into ``folder``; return the paths written.
+
+    With ``parallel`` the report is drawn by a forked child meanwhile (see :func:`build`).
+    """
+    report = None
+    if "report" in groups and parallel:
+        report = _Background(partial(_write_report, analysis, folder))
+    try:
+        written = _write_files(analysis, folder, groups=groups - {"report"}, progress=progress)
+        if report is not None:
+            path, seconds = report.join()
+            analysis.timings["report"] = seconds
+            if progress is not None:
+                progress("report", seconds)
+            written.append(path)
+        elif "report" in groups:
+            draw = partial(_write_report, analysis, folder)
+            written.append(_timed(analysis.timings, progress, "report", draw))
+    except BaseException:
+        if report is not None:
+            report.cancel()
+        raise
+    return written
+
+
+def _write_report(analysis: Analysis, folder: Path) -> Path:
+    from camcad.report import write_report  # here: it loads matplotlib
+
+    return write_report(analysis, folder / "report.html")
+
+
+def _can_fork() -> bool:
+    """Whether a forked child can draw the report beside this process: Linux, two or more CPUs."""
+    return sys.platform.startswith("linux") and hasattr(os, "fork") and len(os.sched_getaffinity(0)) > 1
+
+
+class _Background:
+    """One output stage run in a forked child process; :meth:`join` returns its result or raises its error.
+
+    The child inherits the analysis as it is (fork copies the process), runs
+    the stage, sends back a pickled ``(result, seconds)`` or the exception
+    through a pipe and leaves with :func:`os._exit`, so none of the parent's
+    clean-up (the staged output folder) runs twice.
+    """
+
+    def __init__(self, fn: Callable[[], Any]) -> None:
+        self._read, write = os.pipe()
+        self._pid = os.fork()  # 0 in the child; in the parent 0 again once reaped
+        if self._pid == 0:  # pragma: no cover - the child (coverage does not follow it)
+            os.close(self._read)
+            status = 1
+            try:
+                start = time.perf_counter()
+                result = fn()
+                payload = pickle.dumps(("ok", result, time.perf_counter() - start))
+                status = 0
+            except BaseException as err:  # every failure goes back to the parent
+                payload = pickle.dumps(("error", (type(err).__name__, str(err)), _picklable(err)))
+            try:
+                with os.fdopen(write, "wb") as pipe:
+                    pipe.write(payload)
+            finally:
+                os._exit(status)
+        os.close(write)
+
+    def join(self) -> tuple[Any, float]:
+        """Wait for the child; its result and its duration [s], or raise the exception it raised."""
+        with os.fdopen(self._read, "rb") as pipe:
+            data = pipe.read()
+        os.waitpid(self._pid, 0)
+        self._pid = 0  # reaped: nothing left to cancel
+        if not data:
+            raise ExportError("the report process ended without a result (killed?)")
+        kind, value, extra = pickle.loads(data)
+        if kind == "ok":
+            return value, float(extra)
+        if extra is not None:
+            raise extra
+        name, message = value
+        raise ExportError(f"report: {name}: {message}")
+
+    def cancel(self) -> None:
+        """Stop the child and reap it, unless :meth:`join` did (this process failed or was interrupted)."""
+        if self._pid == 0:
+            return
+        os.kill(self._pid, signal.SIGKILL)  # a child not yet reaped still exists, if only as a zombie
+        os.waitpid(self._pid, 0)
+        self._pid = 0
+        os.close(self._read)
+
+
+def _picklable(err: BaseException) -> BaseException | None:
+    """The exception itself if it survives a pickle round trip, else None (its name and text go instead)."""
+    try:
+        pickle.loads(pickle.dumps(err))
+    except Exception:  # any exception that cannot travel
+        return None
+    return err
+
+
+def _write_files(
     analysis: Analysis, folder: Path, *, groups: set[str], progress: Progress | None
 ) -> list[Path]:
-    """Write the selected output groups into ``folder``; return the paths written."""
+    """Write every selected output group but the report into ``folder``; return the paths written."""
     design, timings = analysis.design, analysis.timings
     plate = design.plate()
     written: list[Path] = []
@@ -399,10 +516,6 @@ def _write_outputs(
 
         fea = analysis.fea
         stage("stress", lambda: write_stress_vtu(folder / "stress.vtu", fea))
-    if "report" in groups:
-        from camcad.report import write_report
-
-        stage("report", lambda: write_report(analysis, folder / "report.html"))
     return written
 
 
