@@ -48,7 +48,11 @@ CurveFn = Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
 
 _STRAIGHT_SAGITTA = 1e-9  # mm: an arc bulging less than this is a line
 _SAMPLES = 24  # per interval and direction while fitting
-_NEWTON_STEPS = 3
+# Newton steps of a projection onto the curve: it starts from the nearest of 26 curve samples of
+# the interval, and the distance is stationary at the foot point, so its error after two steps is
+# far below a nanometre (a third step left every sample's G-code byte-identical and cost 7 %);
+# every iterate is a curve point, so fewer steps can only make the measured distance larger
+_NEWTON_STEPS = 2
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
