@@ -18,7 +18,6 @@ from camcad._version import __version__
 from camcad.design import Design
 from camcad.dynamics import DynamicsResult
 from camcad.extremes import SIDE_WORDS, Side, extremes_rows
-from camcad.fea.results import FeaResult
 from camcad.findings import Finding
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
@@ -28,6 +27,7 @@ from camcad.positive import PositiveDrive
 
 if TYPE_CHECKING:
     from camcad.export.gcode import GcodeProgram
+    from camcad.fea.results import FeaResult  # only typing: the FE package loads when the check runs
     from camcad.toolpath import Toolpath
 
 __all__ = ["Analysis", "motion_summary"]
