@@ -1,6 +1,6 @@
 """The boundary representation of a prism with pockets, as STEP (ISO 10303-42) entity instances.
 
-A :class:`~camcad.export.step.Body` is a prism (a plane region between
+A :class:`Body` is a prism (a plane region between
 closed outlines, extruded along +z) minus pockets opened from its top face.
 Its boundary is exact and small, so it is written here entity by entity:
 
@@ -38,7 +38,6 @@ import itertools
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,10 +46,7 @@ from camcad.errors import ExportError
 from camcad.fit.curve import BSplineCurve
 from camcad.geometry.plate import BoreOutline
 
-if TYPE_CHECKING:
-    from camcad.export.step import Body, Outline
-
-__all__ = ["Entities", "real", "shell"]
+__all__ = ["Body", "Entities", "Outline", "Prism", "real", "shell"]
 
 SAMPLES_PER_SPAN = 8  # polygon points per knot span of a B-spline outline, for the nesting tests only
 CIRCLE_CHORD = 1e-3  # chord tolerance of a sampled circle, relative to its radius
@@ -60,6 +56,39 @@ UP = (0.0, 0.0, 1.0)
 DOWN = (0.0, 0.0, -1.0)
 X_AXIS = (1.0, 0.0, 0.0)
 Y_AXIS = (0.0, 1.0, 0.0)
+
+
+Outline = BSplineCurve | BoreOutline
+"""A closed plane curve in the cam frame [mm]: a periodic B-spline, or a bore with its keyway."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Prism:
+    """A plane region inside ``outer`` and outside every hole, from z = ``z0`` to ``z0 + height`` [mm].
+
+    Outlines may run either way round; the writer orients them. Holes lie
+    inside ``outer`` and apart from each other.
+    """
+
+    outer: Outline
+    holes: tuple[Outline, ...] = ()
+    height: float
+    z0: float = 0.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Body:
+    """One solid of the file: ``prism`` minus every prism in ``cuts``; ``name`` becomes its product name.
+
+    A cut is a pocket: it opens at the prism's top face (``z0 + height`` at
+    or above the top), ends above its bottom, lies in the material (inside
+    the outer outline; a prism hole or another pocket inside it lies in one
+    of its own holes, its islands) and crosses no other outline.
+    """
+
+    name: str
+    prism: Prism
+    cuts: tuple[Prism, ...] = ()
 
 
 def real(value: float) -> str:

@@ -33,15 +33,13 @@ from __future__ import annotations
 import os
 import unicodedata
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camcad._version import __version__
 from camcad.errors import ExportError
-from camcad.export._step_brep import Entities, real, shell
+from camcad.export._step_brep import Body, Entities, Outline, Prism, real, shell
 from camcad.export.atomic import atomic_write
-from camcad.fit.curve import BSplineCurve
 from camcad.geometry.plate import BoreOutline
 
 if TYPE_CHECKING:
@@ -65,39 +63,6 @@ MAX_NAME_CHARS = 250
 LINE_WIDTH = 80  # physical lines of the exchange structure are folded after a comma beyond this
 SCHEMA = "AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }"  # AP214 IS
 UNCERTAINTY_MM = 1e-7
-
-Outline = BSplineCurve | BoreOutline
-"""A closed plane curve in the cam frame [mm]: a periodic B-spline, or a bore with its keyway."""
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Prism:
-    """A plane region inside ``outer`` and outside every hole, from z = ``z0`` to ``z0 + height`` [mm].
-
-    Outlines may run either way round; the writer orients them. Holes lie
-    inside ``outer`` and apart from each other.
-    """
-
-    outer: Outline
-    holes: tuple[Outline, ...] = ()
-    height: float
-    z0: float = 0.0
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Body:
-    """One solid of the file: ``prism`` minus every prism in ``cuts``; ``name`` becomes its product name.
-
-    A cut is a pocket: it opens at the prism's top face (``z0 + height`` at
-    or above the top), ends above its bottom, lies in the material (inside
-    the outer outline; a prism hole or another pocket inside it lies in one
-    of its own holes, its islands) and crosses no other outline.
-    """
-
-    name: str
-    prism: Prism
-    cuts: tuple[Prism, ...] = ()
-
 
 def plate_body(fit: ProfileFit, plate: Plate) -> Body:
     """The cam plate: the fit's periodic B-spline extruded by the plate thickness, minus bore and keyway."""
