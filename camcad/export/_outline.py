@@ -17,7 +17,7 @@ from typing import Protocol
 import numpy as np
 
 from camcad._typing import FloatArray, readonly
-from camcad.fit.curve import BSplineCurve
+from camcad.fit.curve import BSplineCurve, curve_derivatives
 from camcad.toolpath.arcs.biarc import (
     CurveFn,
     Pieces,
@@ -163,8 +163,7 @@ def bspline_area(curve: BSplineCurve) -> float:
     """
     start, end = _span_starts(curve)
     u, weight = _gauss_legendre(start, end, max(curve.degree, 1) + 1)
-    p = curve.evaluate(u)
-    d = curve.evaluate(u, 1)
+    p, d = curve_derivatives(curve, u, 1)
     return 0.5 * float(np.sum(weight * (p[:, 0] * d[:, 1] - p[:, 1] * d[:, 0])))
 
 
