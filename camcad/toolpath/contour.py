@@ -37,7 +37,7 @@ __all__ = [
 DECIMALS = 4
 LINE_SAGITTA = 0.05  # × tolerance: an arc bulging less is written as G1
 _MERGE = 2e-4  # mm: consecutive arcs with centres and radii this close are one circle
-_SNAP = 1e-3  # mm: a tab edge this close to a step's end is put there (the fit ends an arc abeam it)
+_SNAP = 1e-3  # mm: a tab edge this close to a step's end is put there
 
 
 def offset_curve(cam: Cam, distance: float) -> CurveFn:
@@ -83,6 +83,13 @@ class Contour:
     normal: tuple[float, float]  # outward at the start
     distance: float  # mm: the offset from the profile this contour follows
     pieces: Pieces  # the fitted pieces before rounding, in φ order
+    tab_edges: tuple[tuple[float, float], ...] = ()  # points [mm] on the path where a tab starts or ends
+
+    def tabbed_steps(self) -> list[Step]:
+        """The steps split at the tab edges, those over a tab flagged (:func:`split_tabs`)."""
+        if not self.tab_edges:
+            return list(self.steps)
+        return split_tabs(list(self.steps), np.asarray(self.tab_edges))
 
 
 def _signed_area(pieces: Pieces) -> float:
@@ -243,8 +250,9 @@ def fit_contour(
     clockwise
         Travel clockwise around the part (climb milling outside).
     windows
-        φ-windows [rad] over tabs; steps are split at their edges (with arcs,
-        the fit ends an arc abeam each edge, so a split adds no step).
+        φ-windows [rad] over tabs: their edges, on the path abeam the exact
+        curve's, are kept for the passes that ride over the tabs
+        (:meth:`Contour.tabbed_steps`); the fit ignores them.
     arcs
         False for G1 chords only.
 
@@ -252,13 +260,15 @@ def fit_contour(
     -------
     Contour
         Steps from the start point back to it, with the deviation measured on
-        the rounded geometry (before the tab splits and arc merges, which keep
-        every step on its circle or line to within 1e-4 mm).
+        the rounded geometry (before the arc merges and tab splits, which keep
+        every step on its circle or line to within 1e-4 mm). With one
+        interval (no corner) the arc spline closes on itself, so the start
+        lies within the band near ``cam.offset(breaks[0], distance)``, on the
+        first arc (:func:`~camcad.toolpath.arcs.spline.fit_arc_spline`).
     """
     curve = offset_curve(cam, distance)
     try:
-        edges = [a for w in windows for a in w]
-        pieces, _ = fit_arc_spline(curve, breaks, fit_tol, arcs=arcs, nodes=edges)
+        pieces, _ = fit_arc_spline(curve, breaks, fit_tol, arcs=arcs, closed=breaks.size == 2)
     except ValueError as err:  # pragma: no cover - only for a cusp the gouge check missed
         raise DesignLimitError(f"cannot fit the toolpath: {err}") from err
     return _realise(cam, distance, pieces, breaks, tol, clockwise=clockwise, windows=windows)
@@ -307,7 +317,7 @@ def _realise(
     clockwise: bool,
     windows: Sequence[tuple[float, float]],
 ) -> Contour:
-    """Orient, round, measure, merge and split the pieces of ``cam.offset(phi, distance)`` into a contour."""
+    """Orient, round, measure and merge the pieces of ``cam.offset(phi, distance)`` into a contour."""
     curve = offset_curve(cam, distance)
     reverse = (_signed_area(pieces) > 0.0) == clockwise
     steps, real = _emit(pieces, reverse=reverse, tol=tol)
@@ -315,21 +325,40 @@ def _realise(
     if dev > tol:  # pragma: no cover - the fit keeps a margin for rounding
         raise DesignLimitError(f"toolpath deviation {dev:.5f} mm exceeds the tolerance {tol:g} mm")
     steps = _merge(steps)
+    edges: tuple[tuple[float, float], ...] = ()
     if windows:
-        edge_phi = np.asarray([a for w in windows for a in w])
-        steps = split_tabs(steps, np.asarray(curve(edge_phi)[0]))
-    ends = np.array([breaks[0], breaks[-1]])
-    o = cam.offset(ends, distance)
-    sign = -1.0 if reverse else 1.0
-    t_start = o.tangent[1 if reverse else 0] * sign
-    t_end = o.tangent[0 if reverse else 1] * sign
+        at = np.asarray(curve(np.asarray([a for w in windows for a in w]))[0])
+        edges = tuple((float(x), float(y)) for x, y in at)
+    t_lo, t_hi = _end_tangents(pieces)
+    t_start, t_end = (-t_hi, -t_lo) if reverse else (t_lo, t_hi)
+    # outward: the side of the exact curve's normal where the path starts
+    outward = cam.offset(np.array([pieces.lo[0]]), distance).normal[0]
+    normal = np.array([-t_start[1], t_start[0]])
+    normal = normal if float(normal @ outward) > 0.0 else -normal
     return Contour(
         start=steps[0].start,
         steps=tuple(steps),
         max_deviation=dev,
         start_tangent=(float(t_start[0]), float(t_start[1])),
         end_tangent=(float(t_end[0]), float(t_end[1])),
-        normal=(float(o.normal[0, 0]), float(o.normal[0, 1])),
+        normal=(float(normal[0]), float(normal[1])),
         distance=distance,
         pieces=pieces,
+        tab_edges=edges,
     )
+
+
+def _end_tangents(pieces: Pieces) -> tuple[FloatArray, FloatArray]:
+    """Unit tangents (in the direction of increasing φ) where the pieces start and where they end."""
+    last = len(pieces) - 1
+    null = bool(pieces.line[last, 1] and np.all(pieces.start[last, 1] == pieces.end[last, 1]))
+    k_end = 0 if null else 1
+    out = []
+    for i, k, at in ((0, 0, pieces.start[0, 0]), (last, k_end, pieces.end[last, k_end])):
+        if pieces.line[i, k]:
+            d = pieces.end[i, k] - pieces.start[i, k]
+        else:
+            r = at - pieces.center[i, k]
+            d = np.array([-r[1], r[0]]) * (1.0 if pieces.ccw[i, k] else -1.0)
+        out.append(d / np.linalg.norm(d))
+    return out[0], out[1]

@@ -252,6 +252,7 @@ def plan_groove(
         rough_offset=cam.roller_radius,
         max_deviation=max(inner.max_deviation, outer.max_deviation),
         contour_blocks=len(inner.steps) + len(outer.steps),
+        contour_arcs=len(inner.steps) + len(outer.steps),
         notes=tuple(notes),
         operation="groove",
     )

@@ -111,7 +111,7 @@ def cut_contour(
     prog.arc(k_in, *start, (lead_in[0] + ij[0], lead_in[1] + ij[1]), feed=spec.feed)
     tabs = tab_top is not None and z < tab_top
     riding = False
-    for st in contour.steps:
+    for st in contour.tabbed_steps() if tabs else contour.steps:
         if tabs and st.tab and not riding:
             prog.line(z=tab_top, feed=spec.feed)
             riding = True

@@ -72,7 +72,9 @@ class Toolpath:
         Two-way distance between the written finishing contour and the exact
         offset curve, measured after rounding [mm].
     contour_blocks
-        Blocks in one finishing contour (leads excluded).
+        Blocks in one finishing contour (leads excluded; tab edges split its steps).
+    contour_arcs
+        Arcs and lines of the finishing contour's arc spline, before tab edges split them.
     notes
         Remarks for the header (e.g. a keyway left for another operation).
     operation
@@ -91,6 +93,7 @@ class Toolpath:
     rough_offset: float
     max_deviation: float
     contour_blocks: int
+    contour_arcs: int
     notes: tuple[str, ...] = ()
     operation: str = "profile"
 
@@ -305,7 +308,8 @@ def plan_toolpath(
         tab_top=tab_top,
         rough_offset=r + stock,
         max_deviation=finish.max_deviation,
-        contour_blocks=len(finish.steps),
+        contour_blocks=len(finish.tabbed_steps() if tab_top is not None else finish.steps),
+        contour_arcs=len(finish.steps),
         notes=tuple(notes),
     )
 

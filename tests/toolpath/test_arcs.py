@@ -190,22 +190,124 @@ def _piece_tangents(pieces):
     return np.array(starts), np.array(ends)
 
 
-def test_soft_nodes_end_an_arc_in_the_band_of_one_closed_interval():
-    curve, tol = wobble(), 0.004
-    nodes = [1.0, 2.5, 4.0]
-    pieces, dev = fit_arc_spline(curve, [0.0, 2 * np.pi], tol, nodes=nodes)
+def dwelled(r0: float = 40.0, lift: float = 8.0):
+    """A cam-like closed curve r(φ): circles r0 on [0, π/2] and r0 + lift on [π, 3π/2], cycloidal between."""
+
+    def curve(phi):
+        phi = np.asarray(phi, dtype=float)
+        u = np.mod(phi, 2 * np.pi)
+        beta = np.pi / 2
+        r = np.where((u >= np.pi) & (u <= 3 * np.pi / 2), r0 + lift, r0)
+        r1, r2 = np.zeros_like(u), np.zeros_like(u)
+        for start, sign, base in ((np.pi / 2, 1.0, r0), (3 * np.pi / 2, -1.0, r0 + lift)):
+            x = (u - start) / beta
+            on = (x > 0) & (x < 1)
+            r = np.where(on, base + sign * lift * (x - np.sin(2 * np.pi * x) / (2 * np.pi)), r)
+            r1 = np.where(on, sign * lift * (1 - np.cos(2 * np.pi * x)) / beta, r1)
+            r2 = np.where(on, sign * lift * 2 * np.pi * np.sin(2 * np.pi * x) / beta**2, r2)
+        c, s = np.cos(phi), np.sin(phi)
+        p = np.column_stack((r * c, r * s))
+        d1 = np.column_stack((r1 * c - r * s, r1 * s + r * c))
+        d2 = np.column_stack((r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s))
+        return p, d1, d2
+
+    return curve
+
+
+def arc_count(pieces) -> int:
+    return int(np.sum(np.abs(pieces.sweep()) > 0.0) + np.sum(pieces.line & (pieces.length() > 0.0)))
+
+
+@pytest.mark.parametrize("tol", [0.004, 0.001])
+def test_a_closed_curve_closes_on_its_first_arc_one_arc_shorter(tol):
+    """closed=True: one tangent-continuous loop within tol two-way, fewer arcs than the fit held at C(0)."""
+    curve = dwelled()
+    pieces, dev = fit_arc_spline(curve, [0.0, 2 * np.pi], tol, closed=True)
+    held, _ = fit_arc_spline(curve, [0.0, 2 * np.pi], tol)
     assert dev.max() <= tol
-    for phi in nodes:  # an arc ends at each node, within the band abeam C(φ)
-        i = int(np.flatnonzero(pieces.hi == phi)[0])
-        end = pieces.end[i, 1]
-        assert np.linalg.norm(end - curve(np.array([phi]))[0][0]) <= tol
-    # one closed, tangent-continuous path, starting and ending on the curve's tangent at φ = 0
-    assert_allclose(pieces.end[:-1, 1], pieces.start[1:, 0], atol=0)
+    assert_two_way_within(curve, pieces, tol)
+    assert arc_count(pieces) < arc_count(held)
+    # the start moved off C(0) (within the band), and the φ-intervals still make one turn
+    assert pieces.lo[0] != 0.0
+    assert abs(pieces.hi[-1] - pieces.lo[0] - 2 * np.pi) <= 1e-12
+    # a closed chain: every piece starts where the one before ends, the last ends at the start
+    flat_start, flat_end = pieces.start.reshape(-1, 2), pieces.end.reshape(-1, 2)
+    assert_allclose(flat_end, np.roll(flat_start, -1, axis=0), atol=1e-12)
     starts, ends = _piece_tangents(pieces)
-    assert_allclose(ends[:-1], starts[1:], atol=1e-9)
-    assert_allclose(starts[0], [0.0, 1.0], atol=1e-9)
-    assert_allclose(ends[-1], [0.0, 1.0], atol=1e-9)
-    assert_allclose(pieces.end[-1, 1], pieces.start[0, 0], atol=1e-9)
+    assert_allclose(ends, np.roll(starts, -1, axis=0), atol=1e-9)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    px=st.floats(-50.0, 50.0), py=st.floats(-50.0, 50.0), heading=st.floats(-np.pi, np.pi),
+    cx=st.floats(-50.0, 50.0), cy=st.floats(-50.0, 50.0), rho=st.floats(2.0, 80.0), ccw=st.booleans(),
+)  # fmt: skip
+def test_an_arc_touching_a_circle_lands_on_it_with_the_circle_s_tangent(px, py, heading, cx, cy, rho, ccw):
+    """_touching: X lies on both circles, and both travel through X with the same unit tangent."""
+    from camcad.toolpath.arcs.search import _touching
+
+    p, t = np.array([[px, py]]), unit(np.array([heading]))
+    c1, rho1 = np.array([[cx, cy]]), np.array([rho if ccw else -rho])
+    kappa, x, t_x = _touching(p, t, c1, rho1)
+    if not (np.isfinite(kappa[0]) and np.all(np.isfinite(x))) or abs(kappa[0]) < 1e-9:
+        return  # no such arc (p on the circle), or a straight line
+    left = lambda v: np.array([-v[1], v[0]])  # noqa: E731
+    centre = p[0] + left(t[0]) / kappa[0]  # the arc leaving p along t with curvature κ
+    scale = max(1.0, abs(1.0 / kappa[0]), rho)
+    assert abs(np.linalg.norm(x[0] - centre) - 1.0 / abs(kappa[0])) <= 1e-9 * scale
+    assert abs(np.linalg.norm(x[0] - c1[0]) - rho) <= 1e-9 * scale
+    assert abs(np.linalg.norm(t_x[0]) - 1.0) <= 1e-9
+    # travelling with curvature κ (ρ₁) the centre lies 1/κ (ρ₁) along the left normal
+    assert_allclose(x[0] + left(t_x[0]) / kappa[0], centre, atol=1e-8 * scale)
+    assert_allclose(x[0] + left(t_x[0]) * rho1[0], c1[0], atol=1e-8 * scale)
+
+
+def test_the_dwells_of_a_curve_are_found_as_its_circles():
+    """_circles: the two dwells of dwelled(), centred on the origin, radii 40 and 48, over their φ-ranges."""
+    from camcad.toolpath.arcs.search import _circles, _table
+
+    phi = _table(0.0, 2 * np.pi)
+    pts, d1, d2 = dwelled()(phi)
+    found = _circles(pts, d1, d2)
+    assert_allclose(found.center, np.zeros((2, 2)), atol=1e-9)
+    assert_allclose(found.rho, [40.0, 48.0], rtol=1e-12)  # counter-clockwise: positive
+    step = phi[1] - phi[0]
+    assert_allclose(phi[found.first], [0.0, np.pi], atol=1.01 * step)
+    assert_allclose(phi[found.last], [np.pi / 2, 3 * np.pi / 2], atol=1.01 * step)
+    # an ellipse has no stretch of constant curvature
+    pts, d1, d2 = ellipse(60.0, 35.0)(phi)
+    assert _circles(pts, d1, d2).rho.size == 0
+
+
+def test_states_landed_on_a_dwell_lie_on_its_circle_and_their_arcs_are_in_tolerance():
+    """_onto_circles: from states on the rise before a dwell, each new state is on the dwell's circle with its
+    tangent, ahead of its parent, and the arc to it is within tol of the curve (independent dense check)."""
+    from camcad.toolpath.arcs.search import _circles, _Layer, _onto_circles, _table
+
+    curve, tol = dwelled(), 0.004
+    phi = _table(0.0, 2 * np.pi)
+    pts, d1, d2 = curve(phi)
+    circles = _circles(pts, d1, d2)
+    j = np.arange(470, 512)  # φ ≈ 165° … 180°, the end of the rise to the dwell at r = 48 (φ ≥ 180°)
+    tan = d1 / np.linalg.norm(d1, axis=1)[:, None]
+    layer = _Layer(j, pts[j], tan[j], np.zeros(j.size, int), None, np.zeros(j.size), phi[j])
+    got = _onto_circles(curve, layer, circles, phi, pts, tol, 512)
+    assert got is not None and got.j.size > 0
+    assert_allclose(np.linalg.norm(got.p, axis=1), 48.0, atol=1e-9)
+    assert_allclose(np.einsum("ij,ij->i", got.p, got.t), 0.0, atol=1e-9)  # tangent ⟂ radius
+    assert np.all(got.p[:, 0] * got.t[:, 1] - got.p[:, 1] * got.t[:, 0] > 0.0)  # counter-clockwise
+    assert np.all(got.at > layer.at[got.parent])
+    for i in range(got.j.size):  # each arc against the curve over its own φ-span, densely
+        exact = curve(np.linspace(got.arc.lo[i], got.arc.hi[i], 4001))[0]
+        arc = np.vstack((got.arc.start[i, 0], sample_pieces(take(got.arc, i), 400)[0, 0], got.arc.end[i, 0]))
+        assert dense_distance(arc, exact).max() <= tol * 1.001
+        assert dense_distance(exact[::3], arc).max() <= tol * 1.001
+
+
+def take(pieces, i):
+    from camcad.toolpath.arcs.biarc import take_pieces
+
+    return take_pieces(pieces, np.array([i]))
 
 
 def test_a_stalled_arc_search_raises_its_own_error():

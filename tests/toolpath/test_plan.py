@@ -186,6 +186,60 @@ def test_tabs_lift_the_tool_on_passes_below_tab_top():
     assert len(lifts) == design.gcode.tab_count * passes_below
 
 
+def _pass_xy(tp: Toolpath, label: str) -> list:
+    """The XY moves of the pass whose comment starts with ``label``, leads excluded."""
+    start = next(k for k, m in enumerate(tp.moves) if m.note.startswith(label))
+    stop = next((k for k, m in enumerate(tp.moves[start + 1 :], start + 1) if m.note), len(tp.moves))
+    xy = [m for m in tp.moves[start:stop] if m.kind is not MoveKind.RAPID and m.start[:2] != m.end[:2]]
+    return xy[1:-1]
+
+
+def test_tabs_split_the_contour_where_needed_and_leave_the_path_alone():
+    """With tabs the finishing pass runs the same arcs (same circles, every vertex kept), split at most twice
+    per tab; a roughing pass above the tabs is not split at all."""
+    design, cam, tp = planned("tabs-bore-coolant")
+    spec = replace(design.gcode, tab_count=0)
+    plain = plan_toolpath(cam, spec, name="x", thickness=design.cam.thickness, bore=design.cam.bore)
+    tabbed, untabbed = _pass_xy(tp, "profile finishing"), _pass_xy(plain, "profile finishing")
+    assert len(untabbed) == plain.contour_arcs == tp.contour_arcs == plain.contour_blocks
+    assert len(tabbed) == tp.contour_blocks
+    assert len(untabbed) < len(tabbed) <= len(untabbed) + 2 * design.gcode.tab_count
+    circles = lambda moves: {(m.kind, m.center) for m in moves if m.kind.is_arc}  # noqa: E731
+    assert circles(tabbed) == circles(untabbed)
+    assert {m.end[:2] for m in untabbed} <= {m.end[:2] for m in tabbed}
+    above = [z for z in tp.levels if z >= tp.tab_top]
+    assert above, "the sample needs a roughing pass above the tabs"
+    label = "profile roughing pass 1/"
+    assert len(_pass_xy(tp, label)) == len(_pass_xy(plain, label))
+
+
+def _tangent(m, at_end: bool) -> np.ndarray:
+    """Unit XY tangent of a move, in its direction of travel, at its end or start."""
+    p = np.array(m.end[:2] if at_end else m.start[:2])
+    if not m.kind.is_arc:
+        d = np.array(m.end[:2]) - np.array(m.start[:2])
+        return d / np.linalg.norm(d)
+    r = p - np.array(m.center)
+    t = np.array([-r[1], r[0]]) * (1.0 if m.kind is MoveKind.CCW else -1.0)
+    return t / np.linalg.norm(t)
+
+
+@pytest.mark.parametrize("config", ALL)
+def test_leads_join_the_contour_tangentially(config):
+    """Each lead-in ends along the contour's first step and each lead-out leaves along its last (the contour
+    may start off the exact curve, within the band, where its loop closes)."""
+    _, _, tp = planned(config)
+    labels = [m.note.splitlines()[0] for m in tp.moves if m.note.startswith("profile ")]
+    assert labels
+    for label in labels:
+        start = next(k for k, m in enumerate(tp.moves) if m.note.startswith(label))
+        stop = next((k for k, m in enumerate(tp.moves[start + 1 :], start + 1) if m.note), len(tp.moves))
+        xy = [m for m in tp.moves[start:stop] if m.kind is not MoveKind.RAPID and m.start[:2] != m.end[:2]]
+        # 4-decimal output turns a tangent by at most ~1e-4 mm over the lead or step radius
+        assert np.linalg.norm(_tangent(xy[0], True) - _tangent(xy[1], False)) <= 1e-3, label
+        assert np.linalg.norm(_tangent(xy[-2], True) - _tangent(xy[-1], False)) <= 1e-3, label
+
+
 def test_bore_is_helix_milled_inside_its_wall():
     design, _, tp = planned("tabs-bore-coolant")
     bore = [m for m in tp.moves if m.kind.is_arc and math.hypot(*m.end[:2]) < design.cam.bore / 2]

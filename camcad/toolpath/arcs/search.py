@@ -4,17 +4,20 @@ Layer k holds the end states (curve sample, point, tangent) reachable with k
 tangent-continuous single arcs from the start node. Each state's arcs are
 screened against curve samples for every aim in the band at once; every arc
 may end at any sample it still covers, and of all those ends each cell of
-(normal offset, tangent error) keeps the one farthest along the curve. The
+(normal offset, tangent error) keeps the one farthest along the curve.
+Stretches of constant curvature (a cam's dwells) add states: the arc from a
+state that touches such a circle lands on it with the circle's tangent
+(:func:`_onto_circles`), which the sampled aims hit only by chance. The
 search stops at the first layer from which a measured biarc reaches the end
-node, so it finds the fewest arcs its grid of states allows.
+node, or, on a closed curve, one arc reaches back onto the path's own first
+arc (:func:`_close_loop`), so it finds the fewest arcs its grid of states
+allows.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -27,22 +30,32 @@ from camcad.toolpath.arcs.biarc import (
     arc_from_tangent,
     biarc_pieces,
     cross,
-    curve_nodes,
     distance_to_pieces,
     measure_deviation,
+    norm2,
     take_pieces,
 )
 
 __all__ = ["search_arcs"]
 
 _TABLE_STEP = 2.0 * np.pi / 1024  # rad between curve samples the arcs are screened against
-_AIMS = 20  # aimed samples per state
-_AIM_OFFSETS = np.linspace(-0.9, 0.9, 7)  # × band: aims moved along the normal
+_AIMS = 14  # aimed samples per state
+_AIM_OFFSETS = np.linspace(-0.9, 0.9, 5)  # × band: aims moved along the normal
 _PROXY = 0.97  # × tolerance: band of the sampled screen (each kept arc is then measured)
-_OFFSET_CELLS, _TURN_CELLS = 11, 6  # cells across the band; tangent cells each side of zero
+_OFFSET_CELLS, _TURN_CELLS = 15, 8  # cells across the band; tangent cells each side of zero
 _FINISH_RATIOS = np.array([0.5, 0.7, 1.0, 1.4, 2.0])
 _CLOSE_TURN = 0.2  # rad: a closing biarc may turn this much more than the curve (no loops)
 _MAX_LAYERS = 2000
+# samples per arc measuring a layer's arcs: the screen has checked every table sample of each arc
+# already, and a written contour is measured again after rounding on 48 (the certificate)
+_LAYER_SAMPLES = 16
+_FIELDS = fields(Pieces)
+_LOOP_STATES = 64  # farthest states of a layer tried for a loop closure
+_LOOP_NEWTON = 4  # Newton steps projecting a point onto the curve (a loop's start, a circle's state)
+_CIRCLE_RUN = 4  # samples: a stretch of constant curvature at least this long is a circle to land on
+_CIRCLE_SAME = 1e-6  # mm: samples whose centres and radii of curvature agree this closely share a circle
+_CIRCLE_LARGEST = 1e6  # mm: a larger radius is a straight line, not a circle
+_CIRCLE_STATES = 8  # states kept per layer on circles ahead
 
 
 def _left(t: FloatArray) -> FloatArray:
@@ -59,6 +72,7 @@ class _Layer:
     parent: np.ndarray
     arc: Pieces | None
     dev: FloatArray
+    at: FloatArray  # φ [rad] of the curve abeam each state (the sample's, or between samples)
 
 
 def _single(lo: FloatArray, hi: FloatArray, p: FloatArray, t: FloatArray, q: FloatArray) -> Pieces:
@@ -73,24 +87,15 @@ def _single(lo: FloatArray, hi: FloatArray, p: FloatArray, t: FloatArray, q: Flo
     )  # fmt: skip
 
 
-def _table(a: float, b: float, soft: Sequence[float]) -> tuple[FloatArray, np.ndarray]:
-    """φ samples from a to b with every soft node among them, and the indices that stop an arc."""
-    cuts = [a, *[s for s in soft if a < s < b], b]
-    parts, stops = [], []
-    count = 0
-    for lo, hi in itertools.pairwise(cuts):
-        m = max(4, math.ceil((hi - lo) / _TABLE_STEP))
-        parts.append(np.linspace(lo, hi, m + 1)[:-1])
-        count += m
-        stops.append(count)
-    return np.concatenate([*parts, [b]]), np.asarray(stops)
+def _table(a: float, b: float) -> FloatArray:
+    """φ samples [rad] from a to b, about ``_TABLE_STEP`` apart."""
+    return np.linspace(a, b, max(4, math.ceil((b - a) / _TABLE_STEP)) + 1)
 
 
 def _screen(
     j: np.ndarray,
     p: FloatArray,
     t: FloatArray,
-    limit: np.ndarray,
     pts: FloatArray,
     nrm: FloatArray,
     band: float,
@@ -113,7 +118,7 @@ def _screen(
     """
     n = pts.shape[0] - 1
     idx = np.minimum(j[:, None] + np.arange(1, width + 1)[None, :], n)
-    room = np.maximum(np.minimum(limit - j, width), 0)  # samples up to the state's stop
+    room = np.maximum(np.minimum(n - j, width), 0)  # samples up to the end
     frac = (np.arange(_AIMS) + 1.0) / _AIMS
     e = np.minimum(j[:, None] + np.maximum(np.rint(frac[None, :] * room[:, None]).astype(int), 1), n)
     q = pts[e][:, :, None, :] + (_AIM_OFFSETS * band)[None, None, :, None] * nrm[e][:, :, None, :]
@@ -126,7 +131,7 @@ def _screen(
     )  # (3, s, width): a = w·t, b = w·n, |w|²
     lo, hi = _admissible(*abw, band)
     first = _first_out(np.maximum.accumulate(lo, axis=1), np.minimum.accumulate(hi, axis=1), kappa)
-    # an arc's reach ends before its first sample outside the band, or at its state's stop
+    # an arc's reach ends before its first sample outside the band, or at the end
     reach = np.minimum(first, room[:, None]) - 1
     return kappa, reach, abw
 
@@ -208,7 +213,6 @@ def _expand(
     pts: FloatArray,
     tan_ang: FloatArray,
     nrm: FloatArray,
-    stops: np.ndarray,
     band: float,
     width: int,
 ) -> tuple[np.ndarray, np.ndarray, FloatArray]:
@@ -219,13 +223,12 @@ def _expand(
     """
     n = pts.shape[0] - 1
     j, p, t = layer.j, layer.p, layer.t
-    limit = stops[np.minimum(np.searchsorted(stops, j, side="right"), stops.size - 1)]
     todo = np.arange(j.size)
     found: list[tuple[np.ndarray, ...]] = []
     while todo.size:
         jj = j[todo]
-        kappa, reach, abw = _screen(jj, p[todo], t[todo], limit[todo], pts, nrm, band, width)
-        more = np.any(reach == width - 1, axis=1) & (jj + width < limit[todo]) & (width < n)
+        kappa, reach, abw = _screen(jj, p[todo], t[todo], pts, nrm, band, width)
+        more = np.any(reach == width - 1, axis=1) & (jj + width < n) & (width < n)
         s_i, w_i, kk, off, aa, bb, last = _ends(kappa, reach, abw, ~more)
         turn = np.arctan2(kk * aa, 1.0 - kk * bb)
         found.append((todo[s_i], kk, jj[s_i] + 1 + w_i, off, turn, last))
@@ -281,7 +284,7 @@ def _close(
     # degenerate biarc: NaN, or two null pieces
     with np.errstate(divide="ignore", invalid="ignore"):
         pc = biarc_pieces(
-            phi[layer.j[s]], np.full(s.size, phi[n]), layer.p[s], layer.t[s], end, end_t, ratio=ratio
+            layer.at[s], np.full(s.size, phi[n]), layer.p[s], layer.t[s], end, end_t, ratio=ratio
         )
         gap = distance_to_pieces(pts[at], pc).max(axis=1)
     # within tol of the node a biarc could loop unseen: only a state on the node's tangent closes there;
@@ -303,14 +306,241 @@ def _close(
     return int(s[fits[i]]), take_pieces(pc, fits[i : i + 1]), float(dev[i])
 
 
+def _near_samples(
+    p: FloatArray,
+    t: FloatArray,
+    kappa: FloatArray,
+    pts: FloatArray,
+    j0: np.ndarray,
+    j1: np.ndarray | int,
+    tol: float,
+) -> np.ndarray:
+    """Whether the circles (p, t, κ) pass within ``tol`` of 7 curve samples evenly between samples j0 and j1.
+
+    A cheap necessary condition for an arc from sample j0 to j1 to be within
+    ``tol`` of the curve (its circle is), checked before any measurement.
+    """
+    idx = np.rint(j0[:, None] + (j1 - j0)[:, None] * np.linspace(0.0, 1.0, 9)[1:-1]).astype(int)
+    w = pts[np.clip(idx, 0, pts.shape[0] - 1)] - p[:, None, :]
+    b = np.einsum("swi,si->sw", w, _left(t))
+    with np.errstate(invalid="ignore"):
+        out: np.ndarray = np.all(np.abs(_gap(kappa[:, None], b, np.sum(w * w, axis=-1))) <= tol, axis=1)
+    return out
+
+
+def _touching(
+    p: FloatArray, t: FloatArray, c1: FloatArray, rho1: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The arcs from states (p, t) that touch circles (centre c₁, signed radius ρ₁), travelling the same way.
+
+    With n the left normal and w = p − c₁, the arc of signed curvature κ
+    touches the circle where |w + n/κ| = |1/κ − ρ₁|, which is linear in κ:
+    κ = 2(n·w + ρ₁)/(ρ₁² − |w|²); the circles touch at X = c₁ − ρ₁ m with the
+    unit normal m = (κw + n)/(1 − κρ₁). Returns κ (1/mm), X and the unit
+    tangent there (NaN where there is none).
+    """
+    w = p - c1
+    nl = _left(t)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        kappa = 2.0 * (np.sum(nl * w, axis=1) + rho1) / (rho1 * rho1 - np.sum(w * w, axis=1))
+        m = (kappa[:, None] * w + nl) / (1.0 - kappa * rho1)[:, None]
+    x = c1 - rho1[:, None] * m
+    return kappa, x, np.stack((m[:, 1], -m[:, 0]), axis=1)
+
+
+def _abeam(curve: CurveFn, x: FloatArray, guess: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """φ [rad] of the curve point nearest each x, and the point: Newton on (C(φ) − x)·C′(φ) from ``guess``."""
+    phi_x = guess.copy()
+    for _ in range(_LOOP_NEWTON):
+        pt, d1, d2 = curve(phi_x)
+        diff = pt - x
+        g, gp = np.sum(diff * d1, axis=1), np.sum(d1 * d1, axis=1) + np.sum(diff * d2, axis=1)
+        phi_x = phi_x - g / np.where(gp > 0.0, gp, np.sum(d1 * d1, axis=1))
+    return phi_x, curve(phi_x)[0]
+
+
+def _plain(curve: CurveFn, pc: Pieces) -> np.ndarray:
+    """Whether each single arc turns at most ``_CLOSE_TURN`` more than the curve over its φ-span."""
+    grid = pc.lo[:, None] + (pc.hi - pc.lo)[:, None] * np.linspace(0.0, 1.0, 17)
+    _, d1, _ = curve(grid.ravel())
+    turn = np.abs(np.diff(np.unwrap(angle_of(d1).reshape(grid.shape), axis=1), axis=1)).sum(axis=1)
+    out: np.ndarray = np.abs(pc.sweep()[:, 0]) <= turn + _CLOSE_TURN
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class _Circles:
+    """Stretches of constant curvature (a dwell's circle): centres (m, 2), signed radii, sample ranges."""
+
+    center: FloatArray
+    rho: FloatArray
+    first: np.ndarray
+    last: np.ndarray
+
+
+def _circles(pts: FloatArray, d1: FloatArray, d2: FloatArray) -> _Circles:
+    """The runs of at least ``_CIRCLE_RUN`` samples on one circle (centre and radius equal to 1e-6 mm)."""
+    speed = np.linalg.norm(d1, axis=1)
+    kappa = cross(d1, d2) / speed**3
+    with np.errstate(divide="ignore"):
+        rho = 1.0 / kappa
+    center = pts + rho[:, None] * _left(d1 / speed[:, None])
+    same = (np.abs(np.diff(rho)) <= _CIRCLE_SAME) & (norm2(np.diff(center, axis=0)) <= _CIRCLE_SAME)
+    same &= np.isfinite(rho[1:]) & (np.abs(rho[1:]) < _CIRCLE_LARGEST)
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], same.astype(int), [0]))))
+    first, last = edges[::2], edges[1::2]  # run k: samples first[k] … last[k]
+    long = last - first >= _CIRCLE_RUN
+    first, last = first[long], last[long]
+    return _Circles(center[first], rho[first], first, last)
+
+
+def _onto_circles(
+    curve: CurveFn,
+    layer: _Layer,
+    circles: _Circles,
+    phi: FloatArray,
+    pts: FloatArray,
+    tol: float,
+    width: int,
+) -> _Layer | None:
+    """States on a circle of the curve ahead (a dwell's), each reached by one measured arc from the layer.
+
+    A dwell is one arc at best, and it can reach back into the motion before
+    it while its circle stays in the band there; from a state the arc that
+    touches the circle (:func:`_touching`) lands on it with the circle's own
+    tangent, so the next arc can run along the circle. The sampled aims find
+    such a state only by chance. Circles that begin within ``width`` samples
+    of a state are tried; returns the farthest ``_CIRCLE_STATES`` states
+    whose arcs pass the measurement (their arcs, parents and deviations),
+    or None.
+    """
+    k = circles.rho.size
+    s = np.repeat(np.arange(layer.j.size), k)
+    c = np.tile(np.arange(k), layer.j.size)
+    ahead = (circles.last[c] > layer.j[s] + 1) & (circles.first[c] - layer.j[s] <= width)
+    s, c = s[ahead], c[ahead]
+    kappa, x, t_x = _touching(layer.p[s], layer.t[s], circles.center[c], circles.rho[c])
+    # where X lies on the circle: as a turn from the stretch's first sample, in the travel direction
+    sign = np.sign(circles.rho[c])
+    first, last = circles.first[c], circles.last[c]
+    c1 = circles.center[c]
+    ref = angle_of(pts[first] - c1)
+    span = (sign * (angle_of(pts[last] - c1) - ref)) % (2.0 * np.pi)
+    # wrapped about the stretch's middle, so X before the stretch is negative
+    along = (sign * (angle_of(x - c1) - ref) - 0.5 * span + np.pi) % (2.0 * np.pi) - np.pi + 0.5 * span
+    ok = np.isfinite(kappa) & np.all(np.isfinite(x), axis=1) & (along <= span)
+    ok &= np.sum((x - layer.p[s]) * layer.t[s], axis=1) > 0.0  # ahead of the state
+    s, c, x, t_x, along, span, ok_c = s[ok], c[ok], x[ok], t_x[ok], along[ok], span[ok], np.flatnonzero(ok)
+    if s.size == 0:
+        return None
+    first, last = circles.first[c], circles.last[c]
+    guess = phi[first] + along / np.maximum(span, 1e-300) * (phi[last] - phi[first])
+    at, foot = _abeam(curve, x, guess)
+    land = np.searchsorted(phi, at) - 1
+    ok = (norm2(foot - x) <= tol) & (at > layer.at[s]) & (at < phi[-1])
+    ok &= _near_samples(layer.p[s], layer.t[s], kappa[ok_c], pts, layer.j[s], land, tol)
+    # the farthest first: measure at most a few times the states kept
+    order = np.flatnonzero(ok)[np.argsort(-at[ok], kind="stable")][: 4 * _CIRCLE_STATES]
+    s, x, t_x, at = s[order], x[order], t_x[order], at[order]
+    pc = _single(layer.at[s], at, layer.p[s], layer.t[s], x)
+    order = np.flatnonzero(_plain(curve, pc))
+    if order.size == 0:
+        return None
+    pc = take_pieces(pc, order)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dev = measure_deviation(curve, pc)
+    good = np.flatnonzero(dev <= tol)[:_CIRCLE_STATES]
+    if good.size == 0:
+        return None
+    keep = order[good]
+    j = np.searchsorted(phi, at[keep], side="right") - 1
+    return _Layer(j, x[keep], t_x[keep], s[keep], take_pieces(pc, good), dev[good], at[keep])
+
+
+def _close_loop(
+    curve: CurveFn, layers: list[_Layer], states: np.ndarray, phi: FloatArray, pts: FloatArray, tol: float
+) -> tuple[int, Pieces, float, Pieces, float] | None:
+    """One arc from a state of the last layer onto its own first arc, closing a closed curve's loop.
+
+    On a closed curve the path may start anywhere in the band near C(a), so
+    the loop can close with one arc instead of a biarc onto C(a): the arc
+    from the state that touches the circle of the state's first arc
+    (:func:`_touching`) at a point X. The path then starts at X, and its
+    first arc runs from X (before or after C(a) on the same circle) to its
+    end. (Closing onto the second arc instead, dropping the first, never
+    gave fewer arcs on the shipped samples.) Of the closures whose two arcs
+    pass the measurement, the one starting nearest C(a) is taken.
+
+    Returns the state (an index into ``states``), the closing arc, its
+    deviation, the arc from X and its deviation; None when no closure is
+    within ``tol``.
+    """
+    n = phi.size - 1
+    # each state's first arc, traced back through the layers
+    own = states.copy()
+    for k in range(len(layers) - 1, 1, -1):
+        own = layers[k].parent[own]
+    target = layers[1]
+    assert target.arc is not None
+    arc, layer = target.arc, layers[-1]
+    p, t = layer.p[states], layer.t[states]
+    c1 = arc.center[own, 0]
+    rho1 = np.where(arc.ccw[own, 0], arc.r_start[own, 0], -arc.r_start[own, 0])
+    kappa, x, t_x = _touching(p, t, c1, rho1)
+    kappa = np.where(_near_samples(p, t, kappa, pts, layer.j[states], n, tol), kappa, np.nan)
+    # where X lies on the first arc's circle, as a turn from C(a) in the arc's direction
+    sweep1 = np.abs(arc.sweep()[own, 0])
+    rel = angle_of(x - c1) - angle_of(arc.start[own, 0] - c1)
+    along = np.where(arc.ccw[own, 0], 1.0, -1.0) * ((rel + np.pi) % (2.0 * np.pi) - np.pi)
+    ok = (
+        ~arc.line[own, 0] & np.isfinite(kappa) & np.all(np.isfinite(x), axis=1) & (along < sweep1)
+        & (np.linalg.norm(p - x, axis=1) > tol)
+    )  # fmt: skip
+    cand = np.flatnonzero(ok)
+    if cand.size == 0:
+        return None
+    # φ of the curve abeam X, from the first arc's φ-span
+    guess = phi[0] + along[cand] / np.maximum(sweep1[cand], 1e-300) * (target.at[own[cand]] - phi[0])
+    phi_x, _ = _abeam(curve, x[cand], guess)
+    hi = phi[n] + (phi_x - phi[0])
+    lo = layer.at[states[cand]]
+    ok = (phi_x < target.at[own[cand]]) & (hi > lo)
+    cand, phi_x, hi, lo = cand[ok], phi_x[ok], hi[ok], lo[ok]
+    if cand.size == 0:
+        return None
+    close = _single(lo, hi, p[cand], t[cand], x[cand])
+    ok = _plain(curve, close)
+    if not ok.any():
+        return None
+    cand, phi_x, close = cand[ok], phi_x[ok], take_pieces(close, ok)
+    start = _single(phi_x, target.at[own[cand]], x[cand], t_x[cand], target.p[own[cand]])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dev_close, dev_start = measure_deviation(curve, close), measure_deviation(curve, start)
+    fits = np.flatnonzero((dev_close <= tol) & (dev_start <= tol))
+    if fits.size == 0:
+        return None
+    i = int(fits[np.argmin(np.abs(phi_x[fits] - phi[0]))])
+    pick = np.array([i])
+    close, start = take_pieces(close, pick), take_pieces(start, pick)
+    return int(cand[i]), close, float(dev_close[i]), start, float(dev_start[i])
+
+
 def search_arcs(
-    curve: CurveFn, a: float, b: float, tolerance: float, soft: Sequence[float] = ()
+    curve: CurveFn,
+    a: float,
+    b: float,
+    tolerance: float,
+    *,
+    closed: bool = False,
 ) -> tuple[list[Pieces], list[FloatArray]]:
     """Arcs from C(a) to C(b), tangent-continuous, on the curve's own tangents at both ends.
 
-    An arc ends at every φ of ``soft`` (anywhere in the band there). Returns
-    the pieces in φ order (single arcs, then the closing biarc) and their
-    measured deviations.
+    Returns the pieces in φ order (single arcs, then the closing biarc) and their
+    measured deviations. With ``closed`` (a closed curve, b = a + 2π) the
+    loop may instead close with one arc onto its own first arc
+    (:func:`_close_loop`): the path then starts within the band near C(a),
+    on the first arc's circle, and its φ-intervals run from there to the
+    same φ + 2π.
 
     Raises
     ------
@@ -318,24 +548,32 @@ def search_arcs(
         When no arc from some layer passes the measurement even in a band
         shrunk to 0.2 tol.
     """
-    phi, stops = _table(a, b, soft)
-    pts, tan = curve_nodes(curve, phi)
+    phi = _table(a, b)
+    pts, d1, d2 = curve(phi)
+    tan = d1 / norm2(d1)[:, None]
+    circles = _circles(pts, d1, d2)
     tan_ang = angle_of(tan)
     nrm = _left(tan)
-    layers = [_Layer(np.zeros(1, int), pts[:1], tan[:1], np.zeros(1, int), None, np.zeros(1))]
+    zero = np.zeros(1, int)
+    layers = [_Layer(zero, pts[:1], tan[:1], zero, None, np.zeros(1), phi[:1])]
     width = 64
     for _ in range(_MAX_LAYERS):
         layer = layers[-1]
-        near = np.nonzero(layer.j >= (stops[-2] if stops.size > 1 else 0))[0]
-        near = near[np.argsort(-layer.j[near], kind="stable")[:24]]
+        near = np.argsort(-layer.j, kind="stable")
+        if closed and len(layers) > 1 and near.size:
+            loop = _close_loop(curve, layers, near[:_LOOP_STATES], phi, pts, tolerance)
+            if loop:
+                state, close, close_dev, start, start_dev = loop
+                return _trace(layers, int(near[state]), close, close_dev, (start, start_dev))
+        near = near[:24]
         if near.size and (done := _close(curve, _pick(layer, near), phi, pts, tan, tan_ang, tolerance)):
             return _trace(layers, int(near[done[0]]), done[1], done[2])
         band = _PROXY * tolerance
         while True:
-            s, end, kappa = _expand(layer, pts, tan_ang, nrm, stops, band, width)
+            s, end, kappa = _expand(layer, pts, tan_ang, nrm, band, width)
             q = _arc_to(layer.p[s], layer.t[s], kappa, pts[end])
-            pc = _single(phi[layer.j[s]], phi[end], layer.p[s], layer.t[s], q)
-            dev = measure_deviation(curve, pc) if s.size else np.zeros(0)
+            pc = _single(layer.at[s], phi[end], layer.p[s], layer.t[s], q)
+            dev = measure_deviation(curve, pc, samples=_LAYER_SAMPLES) if s.size else np.zeros(0)
             keep = dev <= tolerance
             if keep.any():
                 break
@@ -348,22 +586,44 @@ def search_arcs(
             cross(layer.t[s], q[keep] - layer.p[s]), np.sum((q[keep] - layer.p[s]) * layer.t[s], axis=-1)
         )
         t2 = np.cos(turn)[:, None] * layer.t[s] + np.sin(turn)[:, None] * _left(layer.t[s])
-        layers.append(_Layer(end, q[keep], t2, s, pc, dev))
+        new = _Layer(end, q[keep], t2, s, pc, dev, phi[end])
+        extra = _onto_circles(curve, layer, circles, phi, pts, tolerance, width) if circles.rho.size else None
+        layers.append(new if extra is None else _join(new, extra))
         width = max(32, int(1.5 * np.median(end - layer.j[s])))
     raise ArcSearchStallError("arc search did not close")  # pragma: no cover
 
 
+def _join(a: _Layer, b: _Layer) -> _Layer:
+    """The states of two layers of arcs from the same parents, as one layer."""
+    assert a.arc is not None and b.arc is not None
+    return _Layer(
+        np.concatenate((a.j, b.j)), np.concatenate((a.p, b.p)), np.concatenate((a.t, b.t)),
+        np.concatenate((a.parent, b.parent)),
+        Pieces(**{f.name: np.concatenate((getattr(a.arc, f.name), getattr(b.arc, f.name))) for f in _FIELDS}),
+        np.concatenate((a.dev, b.dev)), np.concatenate((a.at, b.at)),
+    )  # fmt: skip
+
+
 def _pick(layer: _Layer, keep: np.ndarray) -> _Layer:
-    return _Layer(layer.j[keep], layer.p[keep], layer.t[keep], layer.parent[keep], None, layer.dev[keep])
+    return _Layer(
+        layer.j[keep], layer.p[keep], layer.t[keep], layer.parent[keep], None, layer.dev[keep], layer.at[keep]
+    )
 
 
 def _trace(
-    layers: list[_Layer], state: int, close: Pieces, dev: float
+    layers: list[_Layer],
+    state: int,
+    close: Pieces,
+    dev: float,
+    start: tuple[Pieces, float] | None = None,
 ) -> tuple[list[Pieces], list[FloatArray]]:
+    """The arcs of ``state`` back to the start, then ``close``; ``start`` replaces the first arc."""
     pieces, devs = [close], [np.array([dev])]
     for layer in reversed(layers[1:]):
         assert layer.arc is not None
         pieces.append(take_pieces(layer.arc, np.array([state])))
         devs.append(layer.dev[state : state + 1])
         state = int(layer.parent[state])
+    if start is not None:
+        pieces[-1], devs[-1] = start[0], np.array([start[1]])
     return pieces[::-1], devs[::-1]

@@ -33,7 +33,7 @@ def fit_arc_spline(
     tolerance: float,
     *,
     arcs: bool = True,
-    nodes: Sequence[float] | FloatArray = (),
+    closed: bool = False,
 ) -> tuple[Pieces, FloatArray]:
     """Fit a tangent-continuous arc spline (or chords) to C(φ) between sorted φ-breaks within a tolerance.
 
@@ -44,14 +44,17 @@ def fit_arc_spline(
         continuous inside each break interval.
     breaks
         (k + 1,) strictly increasing φ [rad]: points every fit must pass
-        through (motion breakpoints, the start angle, tab edges).
+        through (corners of the curve, the start angle).
     tolerance
         Two-way deviation allowed for each interval [mm].
     arcs
         True for arcs, False for straight chords (the G1-only comparison).
-    nodes
-        φ [rad] where an arc must end, anywhere within the band (tab edges);
-        ignored by chords and by the fallback march.
+    closed
+        True when C is closed (C(φ + 2π) = C(φ)) and ``breaks`` is [a, a + 2π]:
+        the loop may then close with one arc onto its own first arc, so the
+        path starts within the band near C(a) instead of on it (one arc
+        fewer than a closing biarc); the pieces' φ-intervals then run from
+        the start's φ to the same φ + 2π.
 
     Returns
     -------
@@ -87,12 +90,12 @@ def fit_arc_spline(
     edges = np.asarray(breaks, dtype=float)
     if not arcs:
         return march_arcs(curve, edges, tolerance, arcs=False)
-    soft = [float(v) for v in np.asarray(nodes, dtype=float).ravel()]
     parts: list[Pieces] = []
     devs: list[FloatArray] = []
     for a, b in itertools.pairwise(edges):
         try:
-            done, dev = search_arcs(curve, float(a), float(b), tolerance, soft=soft)
+            loop = closed and edges.size == 2
+            done, dev = search_arcs(curve, float(a), float(b), tolerance, closed=loop)
         except ArcSearchStallError:
             fallback, fdev = march_arcs(curve, np.array([a, b]), tolerance, arcs=True)
             done, dev = [fallback], [fdev]
