@@ -14,9 +14,11 @@ Markdown table per shipped sample (``samples/*.toml``):
   (fit, round, measure) the whole program;
 - the asymptotic fewest arcs of a tangent-continuous arc spline within the
   fit band ε (0.8 tol less the rounding allowance, the band the arcs are
-  searched in), N ≈ ∫ (|κ'| / (72√3 ε))^{1/3} ds, and the contour's blocks
-  over it (κ' = dκ/ds of the exact offset curve by central differences of the
-  exact curvature at φ ± 1e-5 rad, integrated on 200 000 midpoints).
+  searched in), N ≈ ∫ (|κ'| / (72√3 ε))^{1/3} ds, and the finishing arc
+  spline's arcs over it (κ' = dκ/ds of the exact offset curve by central
+  differences of the exact curvature at φ ± 1e-5 rad, integrated on 200 000
+  midpoints). Arcs are the spline's pieces before tab edges split them
+  (``Toolpath.contour_arcs``); contour blocks count those splits too.
 
 Every G1 path meets the same two-way tolerance as the biarcs (fit to 0.8 tol,
 measured after rounding), so the ratios compare like with like.
@@ -114,20 +116,21 @@ def main(tolerance: float = 0.005) -> None:
                 arcs.max_deviation,
                 elapsed,
                 least,
-                arcs.contour_blocks / least,
+                arcs.contour_arcs,
+                arcs.contour_arcs / least,
             )
         )
     print(f"G-code blocks at tolerance {tolerance:g} mm (contour = one finishing pass, leads excluded)\n")
     print(
         "| sample | contour biarc | contour G1 greedy | contour G1 uniform | G1 greedy / biarc "
         "| G1 uniform / biarc | program biarc | program G1 greedy | program ratio "
-        "| deviation [mm] | plan time [s] | fewest arcs N | biarc / N |"
+        "| deviation [mm] | plan time [s] | fewest arcs N | arcs | arcs / N |"
     )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in rows:
         print(
             f"| {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]:.1f} | {r[5]:.1f} | {r[6]} | {r[7]} "
-            f"| {r[8]:.1f} | {r[9]:.5f} | {r[10]:.2f} | {r[11]:.1f} | {r[12]:.2f} |"
+            f"| {r[8]:.1f} | {r[9]:.5f} | {r[10]:.2f} | {r[11]:.1f} | {r[12]} | {r[13]:.2f} |"
         )
 
 

@@ -308,7 +308,7 @@ def plan_toolpath(
         tab_top=tab_top,
         rough_offset=r + stock,
         max_deviation=finish.max_deviation,
-        contour_blocks=len(finish.tabbed_steps() if tab_top is not None else finish.steps),
+        contour_blocks=len(finish.tabbed_steps()),
         contour_arcs=len(finish.steps),
         notes=tuple(notes),
     )

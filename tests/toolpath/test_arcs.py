@@ -43,15 +43,18 @@ def wobble(r0: float = 50.0, amp: float = 6.0, k: int = 3):
     def curve(phi):
         phi = np.asarray(phi, dtype=float)
         r = r0 + amp * np.cos(k * phi)
-        r1 = -amp * k * np.sin(k * phi)
-        r2 = -amp * k * k * np.cos(k * phi)
-        c, s = np.cos(phi), np.sin(phi)
-        p = np.column_stack((r * c, r * s))
-        d1 = np.column_stack((r1 * c - r * s, r1 * s + r * c))
-        d2 = np.column_stack((r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s))
-        return p, d1, d2
+        return polar(phi, r, -amp * k * np.sin(k * phi), -amp * k * k * np.cos(k * phi))
 
     return curve
+
+
+def polar(phi, r, r1, r2):
+    """Point, first and second φ-derivative of the polar curve r(φ) from r, r′ and r″."""
+    c, s = np.cos(phi), np.sin(phi)
+    p = np.column_stack((r * c, r * s))
+    d1 = np.column_stack((r1 * c - r * s, r1 * s + r * c))
+    d2 = np.column_stack((r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s))
+    return p, d1, d2
 
 
 def unit(angle):
@@ -205,11 +208,7 @@ def dwelled(r0: float = 40.0, lift: float = 8.0):
             r = np.where(on, base + sign * lift * (x - np.sin(2 * np.pi * x) / (2 * np.pi)), r)
             r1 = np.where(on, sign * lift * (1 - np.cos(2 * np.pi * x)) / beta, r1)
             r2 = np.where(on, sign * lift * 2 * np.pi * np.sin(2 * np.pi * x) / beta**2, r2)
-        c, s = np.cos(phi), np.sin(phi)
-        p = np.column_stack((r * c, r * s))
-        d1 = np.column_stack((r1 * c - r * s, r1 * s + r * c))
-        d2 = np.column_stack((r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s))
-        return p, d1, d2
+        return polar(phi, r, r1, r2)
 
     return curve
 

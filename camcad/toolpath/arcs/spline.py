@@ -4,8 +4,9 @@
 each leaving along the previous arc's end tangent and ending anywhere in the
 tolerance band, found by the layered search of
 :mod:`camcad.toolpath.arcs.search`; the interval closes with a measured
-biarc onto the break node, which stays on the curve with its exact tangent.
-Where that search stalls it falls back to the biarc march of
+biarc onto the break node, which stays on the curve with its exact tangent
+(a closed curve without breaks may instead close with one arc onto its own
+first arc). Where that search stalls it falls back to the biarc march of
 :mod:`camcad.toolpath.arcs.march`. Every accepted piece's two-way deviation is
 measured (:func:`~camcad.toolpath.arcs.biarc.measure_deviation`), so the
 tolerance never rests on an estimate.
@@ -76,9 +77,11 @@ def fit_arc_spline(
     within the band. A breadth-first search keeps, after k arcs, the end
     state farthest along the curve in each cell of (normal offset, tangent
     error); arcs are screened on curve samples (0.97 tol) and each kept arc
-    is measured. The interval closes with a measured biarc onto the break
-    node, which stays on the curve with the curve's tangent, from the first
-    layer where one fits. An interval where that stalls falls back to a
+    is measured; states exactly on the circles of stretches of constant
+    curvature (dwells) are added. The interval closes with a measured biarc
+    onto the break node, which stays on the curve with the curve's tangent,
+    from the first layer where one fits, or, with ``closed``, with one arc
+    onto the path's own first arc. An interval where that stalls falls back to a
     greedy biarc march: from the current node it measures the fits ending on the curve at a geometric
     ladder of angles, then tries up to 1.8 times as far with the end node
     moved inside the band (±0.4 tol along the normal, tangent turned by
