@@ -49,21 +49,6 @@ def _args() -> argparse.Namespace:
     return parser.parse_args()
 
 
-def _contour_runs(moves: Any, kinds: Any) -> list[list[Any]]:
-    """The profile passes: maximal runs of feed moves between rapids."""
-    runs, cur = [], []
-    for m in moves:
-        if m.kind is kinds.RAPID:
-            if cur:
-                runs.append(cur)
-            cur = []
-        else:
-            cur.append(m)
-    if cur:
-        runs.append(cur)
-    return runs
-
-
 def measure(root: Path, samples: Path, out: Path, repeats: int) -> dict[str, dict[str, float]]:
     """Plan every sample, write its program, return the figures per sample."""
     sys.path.insert(0, str(root))
@@ -72,7 +57,6 @@ def measure(root: Path, samples: Path, out: Path, repeats: int) -> dict[str, dic
     toolpath = importlib.import_module("camcad.toolpath")
     writer = importlib.import_module("camcad.export.gcode")
     verify = importlib.import_module("camcad.toolpath.verify")
-    moves = importlib.import_module("camcad.toolpath.moves")
     out.mkdir(parents=True, exist_ok=True)
     figures: dict[str, dict[str, float]] = {}
     for path in sorted(samples.glob("*.toml")):
@@ -90,7 +74,7 @@ def measure(root: Path, samples: Path, out: Path, repeats: int) -> dict[str, dic
         check = toolpath.check_toolpath(
             tp.moves, cam, design.gcode, thickness=design.cam.thickness, bore=design.cam.bore
         )
-        runs = [r for r in _contour_runs(tp.moves, moves.MoveKind) if any(m.kind.is_arc for m in r)]
+        runs = [r for r in verify._runs(tp.moves) if any(m.kind.is_arc for m in r)]
         rough = runs[-2] if len(runs) >= 2 and tp.rough_offset != tp.tool_radius else runs[-1]
         # the verifier's own measure of a finishing contour, applied to the last roughing pass
         rough_h, _, _ = verify._measure_finish(rough, verify._Projector(cam, tp.rough_offset))

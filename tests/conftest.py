@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import shutil
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -63,3 +67,23 @@ def distance_to_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
         t = np.clip(np.einsum("ij,ij->i", points - p, q - p) / np.einsum("ij,ij->i", q - p, q - p), 0, 1)
         dist = np.minimum(dist, np.linalg.norm(points - (p + t[:, None] * (q - p)), axis=1))
     return dist
+
+
+@contextmanager
+def serving(folder: Path) -> Iterator[tuple[Any, str, Path]]:
+    """``camcad serve`` on a free loopback port, in a thread, editing a copy of a shipped sample.
+
+    The copy of quintero_vap_b01 is ``folder``/cam.toml. Yields the server, its URL and the design
+    file; shuts the server down afterwards.
+    """
+    from camcad.serve import make_server
+
+    design = folder / "cam.toml"
+    shutil.copy(ROOT / "samples" / "quintero_vap_b01.toml", design)
+    srv, url = make_server(design, port=0)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    try:
+        yield srv, url, design
+    finally:
+        srv.shutdown()
+        srv.server_close()

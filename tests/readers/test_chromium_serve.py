@@ -10,8 +10,6 @@ and Save writes a file ``load_design`` reads back. No horizontal scroll at
 
 from __future__ import annotations
 
-import shutil
-import threading
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -22,26 +20,19 @@ import pytest
 from camcad.design import load_design
 from camcad.errors import DesignError
 from camcad.pipeline import analyse
-from camcad.serve import make_server
+from tests.conftest import serving
 from tests.readers.browser import chromium
 
 pytestmark = pytest.mark.slow
 
-SAMPLES = Path(__file__).resolve().parents[2] / "samples"
 WAIT = 60.0  # s, for one analysis to come back under a loaded CI machine
 SETTLED = "document.body.dataset.busy === '0'"  # every change typed has been analysed and drawn
 
 
 @pytest.fixture(scope="module")
 def served(tmp_path_factory):
-    design = tmp_path_factory.mktemp("serve") / "cam.toml"
-    shutil.copy(SAMPLES / "quintero_vap_b01.toml", design)
-    srv, url = make_server(design, port=0)
-    thread = threading.Thread(target=srv.serve_forever, daemon=True)
-    thread.start()
-    yield url, design
-    srv.shutdown()
-    srv.server_close()
+    with serving(tmp_path_factory.mktemp("serve")) as (_, url, design):
+        yield url, design
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,6 @@ import json
 import math
 import shutil
 import sys
-import threading
 import zipfile
 from dataclasses import replace
 from pathlib import Path
@@ -20,9 +19,9 @@ import pytest
 from camcad.design import load_design, parse_design
 from camcad.errors import DesignError
 from camcad.pipeline import analyse
-from camcad.serve import make_server
 from camcad.serve.form import design_data, form_groups, toml_text
 from camcad.serve.payload import evaluate
+from tests.conftest import serving
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -101,14 +100,8 @@ def test_payload_numbers_equal_the_python_api():
 
 @pytest.fixture
 def server(tmp_path):
-    design = tmp_path / "cam.toml"
-    shutil.copy(SAMPLES / "quintero_vap_b01.toml", design)
-    srv, _ = make_server(design, port=0)
-    thread = threading.Thread(target=srv.serve_forever, daemon=True)
-    thread.start()
-    yield srv, design
-    srv.shutdown()
-    srv.server_close()
+    with serving(tmp_path) as (srv, _, design):
+        yield srv, design
 
 
 def _request(srv, method, path, body=None, *, host="127.0.0.1", kind="application/json"):
