@@ -28,6 +28,7 @@ from camcad._typing import FloatArray, readonly
 __all__ = [
     "CurveFn",
     "Pieces",
+    "abeam",
     "angle_of",
     "arc_from_tangent",
     "biarc_pieces",
@@ -40,6 +41,7 @@ __all__ = [
     "norm2",
     "offset_pieces",
     "sample_pieces",
+    "single_arcs",
     "take_pieces",
 ]
 
@@ -53,6 +55,7 @@ _SAMPLES = 24  # per interval and direction while fitting
 # far below a nanometre (a third step left every sample's G-code byte-identical and cost 7 %);
 # every iterate is a curve point, so fewer steps can only make the measured distance larger
 _NEWTON_STEPS = 2
+_ABEAM_STEPS = 4  # Newton steps of abeam() from a guess that is not a nearby sample
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -463,3 +466,26 @@ def concat_pieces(parts: Sequence[Pieces]) -> Pieces:
     joined = {f: np.concatenate([getattr(p, f) for p in parts]) for f in fields}
     order = np.argsort(joined["lo"], kind="stable")
     return Pieces(**{f: v[order] for f, v in joined.items()})
+
+
+def single_arcs(lo: FloatArray, hi: FloatArray, p: FloatArray, t: FloatArray, q: FloatArray) -> Pieces:
+    """One arc per φ-interval [rad]: from p [mm] along the unit tangent t to q, then an empty piece at q."""
+    center, radius, ccw, line = arc_from_tangent(p, t, q)
+    zero = np.zeros_like(radius)
+    return Pieces(
+        lo=lo, hi=hi, start=np.stack((p, q), axis=1), end=np.stack((q, q), axis=1),
+        center=np.stack((center, q), axis=1), r_start=np.stack((radius, zero), axis=1),
+        r_end=np.stack((radius, zero), axis=1), ccw=np.stack((ccw, np.zeros_like(ccw)), axis=1),
+        line=np.stack((line, np.ones_like(line)), axis=1),
+    )  # fmt: skip
+
+
+def abeam(curve: CurveFn, x: FloatArray, guess: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """φ [rad] of the curve point nearest each x, and the point: Newton on (C(φ) − x)·C′(φ) from ``guess``."""
+    phi_x = guess.copy()
+    for _ in range(_ABEAM_STEPS):
+        pt, d1, d2 = curve(phi_x)
+        diff = pt - x
+        g, gp = np.sum(diff * d1, axis=1), np.sum(d1 * d1, axis=1) + np.sum(diff * d2, axis=1)
+        phi_x = phi_x - g / np.where(gp > 0.0, gp, np.sum(d1 * d1, axis=1))
+    return phi_x, curve(phi_x)[0]

@@ -26,13 +26,14 @@ from camcad.errors import ArcSearchStallError
 from camcad.toolpath.arcs.biarc import (
     CurveFn,
     Pieces,
+    abeam,
     angle_of,
-    arc_from_tangent,
     biarc_pieces,
     cross,
     distance_to_pieces,
     measure_deviation,
     norm2,
+    single_arcs,
     take_pieces,
 )
 
@@ -51,7 +52,6 @@ _MAX_LAYERS = 2000
 _LAYER_SAMPLES = 16
 _FIELDS = fields(Pieces)
 _LOOP_STATES = 64  # farthest states of a layer tried for a loop closure
-_LOOP_NEWTON = 4  # Newton steps projecting a point onto the curve (a loop's start, a circle's state)
 _CIRCLE_RUN = 4  # samples: a stretch of constant curvature at least this long is a circle to land on
 _CIRCLE_SAME = 1e-6  # mm: samples whose centres and radii of curvature agree this closely share a circle
 _CIRCLE_LARGEST = 1e6  # mm: a larger radius is a straight line, not a circle
@@ -73,18 +73,6 @@ class _Layer:
     arc: Pieces | None
     dev: FloatArray
     at: FloatArray  # φ [rad] of the curve abeam each state (the sample's, or between samples)
-
-
-def _single(lo: FloatArray, hi: FloatArray, p: FloatArray, t: FloatArray, q: FloatArray) -> Pieces:
-    """One arc per interval (from p along t to q), then an empty second piece at q."""
-    center, radius, ccw, line = arc_from_tangent(p, t, q)
-    zero = np.zeros_like(radius)
-    return Pieces(
-        lo=lo, hi=hi, start=np.stack((p, q), axis=1), end=np.stack((q, q), axis=1),
-        center=np.stack((center, q), axis=1), r_start=np.stack((radius, zero), axis=1),
-        r_end=np.stack((radius, zero), axis=1), ccw=np.stack((ccw, np.zeros_like(ccw)), axis=1),
-        line=np.stack((line, np.ones_like(line)), axis=1),
-    )  # fmt: skip
 
 
 def _table(a: float, b: float) -> FloatArray:
@@ -348,17 +336,6 @@ def _touching(
     return kappa, x, np.stack((m[:, 1], -m[:, 0]), axis=1)
 
 
-def _abeam(curve: CurveFn, x: FloatArray, guess: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """φ [rad] of the curve point nearest each x, and the point: Newton on (C(φ) − x)·C′(φ) from ``guess``."""
-    phi_x = guess.copy()
-    for _ in range(_LOOP_NEWTON):
-        pt, d1, d2 = curve(phi_x)
-        diff = pt - x
-        g, gp = np.sum(diff * d1, axis=1), np.sum(d1 * d1, axis=1) + np.sum(diff * d2, axis=1)
-        phi_x = phi_x - g / np.where(gp > 0.0, gp, np.sum(d1 * d1, axis=1))
-    return phi_x, curve(phi_x)[0]
-
-
 def _plain(curve: CurveFn, pc: Pieces) -> np.ndarray:
     """Whether each single arc turns at most ``_CLOSE_TURN`` more than the curve over its φ-span."""
     grid = pc.lo[:, None] + (pc.hi - pc.lo)[:, None] * np.linspace(0.0, 1.0, 17)
@@ -435,14 +412,14 @@ def _onto_circles(
         return None
     first, last = circles.first[c], circles.last[c]
     guess = phi[first] + along / np.maximum(span, 1e-300) * (phi[last] - phi[first])
-    at, foot = _abeam(curve, x, guess)
+    at, foot = abeam(curve, x, guess)
     land = np.searchsorted(phi, at) - 1
     ok = (norm2(foot - x) <= tol) & (at > layer.at[s]) & (at < phi[-1])
     ok &= _near_samples(layer.p[s], layer.t[s], kappa[ok_c], pts, layer.j[s], land, tol)
     # the farthest first: measure at most a few times the states kept
     order = np.flatnonzero(ok)[np.argsort(-at[ok], kind="stable")][: 4 * _CIRCLE_STATES]
     s, x, t_x, at = s[order], x[order], t_x[order], at[order]
-    pc = _single(layer.at[s], at, layer.p[s], layer.t[s], x)
+    pc = single_arcs(layer.at[s], at, layer.p[s], layer.t[s], x)
     order = np.flatnonzero(_plain(curve, pc))
     if order.size == 0:
         return None
@@ -501,19 +478,19 @@ def _close_loop(
         return None
     # φ of the curve abeam X, from the first arc's φ-span
     guess = phi[0] + along[cand] / np.maximum(sweep1[cand], 1e-300) * (target.at[own[cand]] - phi[0])
-    phi_x, _ = _abeam(curve, x[cand], guess)
+    phi_x, _ = abeam(curve, x[cand], guess)
     hi = phi[n] + (phi_x - phi[0])
     lo = layer.at[states[cand]]
     ok = (phi_x < target.at[own[cand]]) & (hi > lo)
     cand, phi_x, hi, lo = cand[ok], phi_x[ok], hi[ok], lo[ok]
     if cand.size == 0:
         return None
-    close = _single(lo, hi, p[cand], t[cand], x[cand])
+    close = single_arcs(lo, hi, p[cand], t[cand], x[cand])
     ok = _plain(curve, close)
     if not ok.any():
         return None
     cand, phi_x, close = cand[ok], phi_x[ok], take_pieces(close, ok)
-    start = _single(phi_x, target.at[own[cand]], x[cand], t_x[cand], target.p[own[cand]])
+    start = single_arcs(phi_x, target.at[own[cand]], x[cand], t_x[cand], target.p[own[cand]])
     with np.errstate(divide="ignore", invalid="ignore"):
         dev_close, dev_start = measure_deviation(curve, close), measure_deviation(curve, start)
     fits = np.flatnonzero((dev_close <= tol) & (dev_start <= tol))
@@ -572,7 +549,7 @@ def search_arcs(
         while True:
             s, end, kappa = _expand(layer, pts, tan_ang, nrm, band, width)
             q = _arc_to(layer.p[s], layer.t[s], kappa, pts[end])
-            pc = _single(layer.at[s], phi[end], layer.p[s], layer.t[s], q)
+            pc = single_arcs(layer.at[s], phi[end], layer.p[s], layer.t[s], q)
             dev = measure_deviation(curve, pc, samples=_LAYER_SAMPLES) if s.size else np.zeros(0)
             keep = dev <= tolerance
             if keep.any():
