@@ -18,7 +18,10 @@ Markdown table per shipped sample (``samples/*.toml``):
   spline's arcs over it (κ' = dκ/ds of the exact offset curve by central
   differences of the exact curvature at φ ± 1e-5 rad, integrated on 200 000
   midpoints). Arcs are the spline's pieces before tab edges split them
-  (``Toolpath.contour_arcs``); contour blocks count those splits too.
+  (``Toolpath.contour_arcs``); contour blocks count those splits too;
+- the same with ``[gcode] fewest_arcs = true`` (the search's loop refitted
+  with arcs dropped, :mod:`camcad.toolpath.arcs.refine`): its arcs, arcs / N,
+  its measured deviation and its plan time.
 
 Every G1 path meets the same two-way tolerance as the biarcs (fit to 0.8 tol,
 measured after rounding), so the ratios compare like with like.
@@ -100,6 +103,9 @@ def main(tolerance: float = 0.005) -> None:
         lines = plan_toolpath(cam, spec, arcs=False, **kw)
         uniform = uniform_chords(cam, spec.tool_radius, 0.8 * tolerance)
         least = fewest_arcs(cam, spec.tool_radius, _fit_tolerance(tolerance))
+        start = time.perf_counter()
+        thin = plan_toolpath(cam, replace(spec, fewest_arcs=True), **kw)
+        thin_time = time.perf_counter() - start
         prog_arcs = count_blocks(render_gcode(arcs))
         prog_lines = count_blocks(render_gcode(lines))
         rows.append(
@@ -118,19 +124,25 @@ def main(tolerance: float = 0.005) -> None:
                 least,
                 arcs.contour_arcs,
                 arcs.contour_arcs / least,
+                thin.contour_arcs,
+                thin.contour_arcs / least,
+                thin.max_deviation,
+                thin_time,
             )
         )
     print(f"G-code blocks at tolerance {tolerance:g} mm (contour = one finishing pass, leads excluded)\n")
     print(
         "| sample | contour biarc | contour G1 greedy | contour G1 uniform | G1 greedy / biarc "
         "| G1 uniform / biarc | program biarc | program G1 greedy | program ratio "
-        "| deviation [mm] | plan time [s] | fewest arcs N | arcs | arcs / N |"
+        "| deviation [mm] | plan time [s] | fewest arcs N | arcs | arcs / N "
+        "| fewest_arcs: arcs | arcs / N | deviation [mm] | plan time [s] |"
     )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in rows:
         print(
             f"| {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]:.1f} | {r[5]:.1f} | {r[6]} | {r[7]} "
-            f"| {r[8]:.1f} | {r[9]:.5f} | {r[10]:.2f} | {r[11]:.1f} | {r[12]} | {r[13]:.2f} |"
+            f"| {r[8]:.1f} | {r[9]:.5f} | {r[10]:.2f} | {r[11]:.1f} | {r[12]} | {r[13]:.2f} "
+            f"| {r[14]} | {r[15]:.2f} | {r[16]:.5f} | {r[17]:.2f} |"
         )
 
 

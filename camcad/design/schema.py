@@ -344,6 +344,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "lead_radius": _Rule("float", check=_length),
         "start_angle": _Rule("float", check=_between(-360.0, 360.0, " degrees"), scale=DEG),
         "tab_count": _Rule("int", check=_count(0, MAX_TABS, "tabs around one contour")),
+        "fewest_arcs": _Rule("bool"),
         "tab_width": _Rule("float", check=_length),
         "tab_height": _Rule("float", check=_length),
         "clearance_height": _Rule("float", check=_length),

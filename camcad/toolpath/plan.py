@@ -354,7 +354,9 @@ def _fit_contours(
     windows = _tab_windows(cam, spec, phi0)
     breaks = _breaks(cam, phi0)
     clockwise = spec.direction is Direction.CLIMB
-    finish = fit_contour(cam, r, breaks, tol, fit_tol, clockwise=clockwise, windows=windows, arcs=arcs)
+    finish = fit_contour(
+        cam, r, breaks, tol, fit_tol, clockwise=clockwise, windows=windows, arcs=arcs, thin=spec.fewest_arcs
+    )
     if stock > 0.0 and arcs:
         # the finishing arc spline offset by the stock (arcs stay arcs), measured; refitted if it misses
         rough = offset_contour(

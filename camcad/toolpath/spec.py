@@ -61,6 +61,7 @@ class GcodeSpec:
     lead_radius: float | None = None  # None: the tool diameter
     start_angle: float = 0.0
     tab_count: int = 0
+    fewest_arcs: bool = False  # refit the finishing arc spline to drop arcs (refine.thin_loop)
     tab_width: float = 6.0
     tab_height: float = 1.0
     clearance_height: float = 10.0

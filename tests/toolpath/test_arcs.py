@@ -252,7 +252,8 @@ def test_an_arc_touching_a_circle_lands_on_it_with_the_circle_s_tangent(px, py, 
         return  # no such arc (p on the circle), or a straight line
     left = lambda v: np.array([-v[1], v[0]])  # noqa: E731
     centre = p[0] + left(t[0]) / kappa[0]  # the arc leaving p along t with curvature κ
-    scale = max(1.0, abs(1.0 / kappa[0]), rho)
+    # nearly coincident circles (κρ₁ → 1) touch at an ill-conditioned point: the error grows as 1/|1 − κρ₁|
+    scale = max(1.0, abs(1.0 / kappa[0]), rho) / min(1.0, abs(1.0 - kappa[0] * rho1[0]))
     assert abs(np.linalg.norm(x[0] - centre) - 1.0 / abs(kappa[0])) <= 1e-9 * scale
     assert abs(np.linalg.norm(x[0] - c1[0]) - rho) <= 1e-9 * scale
     assert abs(np.linalg.norm(t_x[0]) - 1.0) <= 1e-9
@@ -432,3 +433,64 @@ def test_the_screen_reach_is_the_first_sample_a_walk_finds_outside_the_band(seed
         near_tie = np.abs(dist - band) < 1e-9 * max(1.0, float(np.max(np.abs(pts))))
         if walk != first:  # only a sample on the band's edge (to round-off) may be judged either way
             assert near_tie[min(walk, first)]
+
+
+def test_the_refit_s_jacobians_are_its_finite_differences():
+    """refine: dg/dx of every sample's gap and of the four loop equations equal central differences."""
+    from camcad.toolpath.arcs import refine
+
+    rng = np.random.default_rng(7)
+    n = 6
+    x = np.concatenate(([1.0, -2.0, 0.3], rng.uniform(-0.05, 0.05, n), rng.uniform(5.0, 15.0, n)))
+    q = rng.uniform(-30.0, 30.0, (50, 2))
+    seg = rng.integers(0, n, 50)
+    c0, t0 = np.array([0.5, 0.2]), np.array([0.6, 0.8])
+
+    def values(y):
+        loop = refine._joints(y, n)
+        return refine._gaps(loop, q, seg)[0], refine._closure(loop, 2 * np.pi, c0, t0)[0]
+
+    loop = refine._joints(x, n)
+    jac = refine._gaps(loop, q, seg)[1]
+    eq_jac = refine._closure(loop, 2 * np.pi, c0, t0)[1]
+    h = 1e-6
+    for k in range(x.size):
+        e = np.zeros_like(x)
+        e[k] = h
+        (g1, c1), (g0, c0_) = values(x + e), values(x - e)
+        assert_allclose(jac[:, k], (g1 - g0) / (2 * h), rtol=1e-6, atol=1e-6 * np.abs(jac).max())
+        assert_allclose(eq_jac[:, k], (c1 - c0_) / (2 * h), rtol=1e-6, atol=1e-6 * np.abs(eq_jac).max())
+
+
+@cache
+def harmonic_finish():
+    """The finishing path of the shipped quintero_harmonic sample: its exact curve, fit band and start φ."""
+    from camcad.design import load_design
+    from camcad.geometry.cam import Cam
+    from camcad.toolpath.contour import offset_curve
+    from camcad.toolpath.plan import _fit_tolerance
+    from tests.conftest import ROOT
+
+    design = load_design(ROOT / "samples" / "quintero_harmonic.toml")
+    cam = Cam.from_design(design)
+    return offset_curve(cam, design.gcode.tool_radius), _fit_tolerance(design.gcode.tolerance)
+
+
+def test_a_thinned_loop_has_fewer_arcs_is_one_g1_loop_in_tolerance_and_starts_abeam_its_start():
+    """thin=True: arcs dropped by the minimax refit; a dense two-way check, closure and tangents."""
+    curve, tol = harmonic_finish()
+    searched, _ = fit_arc_spline(curve, [0.0, 2 * np.pi], tol, closed=True)
+    pieces, dev = fit_arc_spline(curve, [0.0, 2 * np.pi], tol, closed=True, thin=True)
+    assert arc_count(pieces) <= arc_count(searched) - 1
+    assert dev.max() <= tol
+    assert_two_way_within(curve, pieces, tol)
+    flat_start, flat_end = pieces.start.reshape(-1, 2), pieces.end.reshape(-1, 2)
+    assert_allclose(flat_end, np.roll(flat_start, -1, axis=0), atol=1e-9)
+    starts, ends = _piece_tangents(pieces)
+    assert_allclose(ends, np.roll(starts, -1, axis=0), atol=1e-9)
+    # the loop starts on the normal of C(0), within the band, and its φ-intervals make one turn
+    c0, d0, _ = curve(np.array([0.0]))
+    along = (pieces.start[0, 0] - c0[0]) @ (d0[0] / np.linalg.norm(d0[0]))
+    assert abs(along) <= 1e-9
+    assert np.linalg.norm(pieces.start[0, 0] - c0[0]) <= tol
+    assert pieces.lo[0] == 0.0 and pieces.hi[-1] == 2 * np.pi and np.all(np.diff(pieces.lo) > 0)

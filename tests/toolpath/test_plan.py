@@ -30,6 +30,7 @@ CONFIGS = {
     "tabs-bore-coolant": {"tab_count": 3, "mill_bore": True, "coolant": True},
     "start-75-no-stock": {"start_angle": 75.0, "stock_to_leave": 0.0, "lead_radius": 4.0},
     "grbl-tight": {"dialect": "grbl", "tolerance": 0.002, "tool_diameter": 8.0},
+    "fewest-arcs-tabs": {"fewest_arcs": True, "tab_count": 2},
 }
 
 
@@ -119,6 +120,29 @@ def test_roughing_contour_is_fitted_afresh_when_the_offset_spline_cannot_be_used
     exact = np.asarray(cam.offset(np.linspace(0.0, 2.0 * math.pi, 200_001), tp.rough_offset).point)
     assert distance_to_polyline(path, exact).max() <= design.gcode.tolerance
     assert distance_to_polyline(exact[::4], path).max() <= design.gcode.tolerance
+
+
+def test_fewest_arcs_drops_arcs_and_starts_the_contour_abeam_the_start_angle():
+    """[gcode] fewest_arcs: fewer finishing arcs than the search alone, within the same certificate."""
+    design, cam, tp = planned("fewest-arcs-tabs")
+    plain = plan_toolpath(
+        cam,
+        replace(design.gcode, fewest_arcs=False),
+        name="x",
+        thickness=design.cam.thickness,
+        bore=design.cam.bore,
+    )
+    assert tp.contour_arcs < plain.contour_arcs
+    assert tp.max_deviation <= design.gcode.tolerance
+    # the finishing contour starts on the normal of the exact path at start_angle (to the 4-decimal rounding)
+    from camcad.toolpath.plan import _breaks, _fit_tolerance
+
+    r, tol, phi = design.gcode.tool_radius, design.gcode.tolerance, math.radians(40.0)
+    finish = contour.fit_contour(
+        cam, r, _breaks(cam, phi), tol, _fit_tolerance(tol), clockwise=True, thin=True
+    )
+    point, d1, _ = contour.offset_curve(cam, r)(np.array([phi]))
+    assert abs((np.asarray(finish.start) - point[0]) @ (d1[0] / np.linalg.norm(d1[0]))) <= 1e-4
 
 
 def test_climb_runs_clockwise_and_conventional_counter_clockwise():

@@ -3,6 +3,7 @@
 - :mod:`~camcad.toolpath.arcs.biarc`: pieces (arcs and lines), biarcs,
   chords and the two-way deviation measurement;
 - :mod:`~camcad.toolpath.arcs.search`: the layered search for short arc splines;
+- :mod:`~camcad.toolpath.arcs.refine`: the minimax refit that drops arcs from a closed loop;
 - :mod:`~camcad.toolpath.arcs.march`: the greedy biarc march (fallback, and G1 chords);
 - :mod:`~camcad.toolpath.arcs.spline`: :func:`fit_arc_spline`, which uses them.
 """

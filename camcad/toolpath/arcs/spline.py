@@ -23,6 +23,7 @@ from camcad._typing import FloatArray, readonly
 from camcad.errors import ArcSearchStallError
 from camcad.toolpath.arcs.biarc import CurveFn, Pieces, concat_pieces
 from camcad.toolpath.arcs.march import march_arcs
+from camcad.toolpath.arcs.refine import thin_loop
 from camcad.toolpath.arcs.search import search_arcs
 
 __all__ = ["fit_arc_spline"]
@@ -35,6 +36,7 @@ def fit_arc_spline(
     *,
     arcs: bool = True,
     closed: bool = False,
+    thin: bool = False,
 ) -> tuple[Pieces, FloatArray]:
     """Fit a tangent-continuous arc spline (or chords) to C(φ) between sorted φ-breaks within a tolerance.
 
@@ -56,6 +58,10 @@ def fit_arc_spline(
         path starts within the band near C(a) instead of on it (one arc
         fewer than a closing biarc); the pieces' φ-intervals then run from
         the start's φ to the same φ + 2π.
+    thin
+        With ``closed``: refit the loop with fewer arcs where the measured
+        deviation allows (:func:`~camcad.toolpath.arcs.refine.thin_loop`);
+        the loop then starts abeam C(a).
 
     Returns
     -------
@@ -106,5 +112,7 @@ def fit_arc_spline(
         devs += dev
     out = concat_pieces(parts)
     dev_all = np.concatenate(devs)[np.argsort(np.concatenate([p.lo for p in parts]), kind="stable")]
+    if thin and closed and edges.size == 2 and (fewer := thin_loop(curve, out, tolerance, float(edges[0]))):
+        out, dev_all = fewer
     readonly(dev_all)
     return out, dev_all

@@ -1,0 +1,398 @@
+"""Fewer arcs on a closed arc spline: drop one arc and refit the rest to the curve by minimax.
+
+The layered search (:mod:`camcad.toolpath.arcs.search`) keeps, in each cell
+of end states, the one farthest along the curve. That choice is greedy: a
+short arc before a dwell or a curvature jump sets up the next one, and the
+loop closes where it can. This module takes the search's loop and moves all
+its arcs at once.
+
+A closed tangent-continuous arc spline of n arcs is fixed by its start
+(point p₀, tangent angle θ₀) and each arc's curvature κᵢ and length sᵢ:
+x = (p₀, θ₀, κ₁…κₙ, s₁…sₙ); joint i + 1 is joint i moved along arc i. The
+loop closes when pₙ = p₀ and θₙ = θ₀ + W (W the total turn, ±2π), and it
+starts abeam C(a) when (p₀ − C(a))·T(a) = 0. The fit minimises the largest
+normal gap of curve samples from the circle of the arc each sample lies
+along (between the nearest samples of its two joints). The largest gap is
+not smooth, so Levenberg–Marquardt minimises Σ (g/τ)^(2p) with τ the current
+largest gap and p = 8 (the 16-norm, within a few per cent of the maximum
+once the gaps equioscillate), the four equations held by the KKT system,
+with the Jacobian by hand (a change of κⱼ or sⱼ moves the loop after arc j
+rigidly: a turn about joint j + 1). It is hand-written because
+``scipy.optimize`` costs 0.3 s to import in a build that otherwise needs
+no SciPy, and its SLSQP with differenced gradients took 10 s per loop here.
+
+:func:`thin_loop` tries, for each arc i, the loop with arcs i − 1, i, i + 1
+replaced by a biarc between the joints around them (the rest unchanged, so
+the loop stays closed; the arcs next to the start instead give half their
+length to each neighbour), refits the candidates whose guess starts nearest
+the curve, and keeps the first whose two-way deviation, measured by
+:func:`~camcad.toolpath.arcs.biarc.measure_deviation`, is within the
+tolerance; it stops after ``_TRIES`` failed refits in a row. It runs only
+when asked (``[gcode] fewest_arcs``): it drops 1–4 arcs on every shipped
+sample (every loop within 1.2 times the asymptotic fewest arcs) at 0.3–0.8 s
+more per contour.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from camcad._typing import FloatArray
+from camcad.toolpath.arcs.biarc import CurveFn, Pieces, abeam, angle_of, cross, measure_deviation, single_arcs
+
+__all__ = ["thin_loop"]
+
+_STRETCH = (1.0, 2.0)  # × the Gauss–Newton step: a step of twice the length is taken when it does better
+_POWER, _POWER_MAX = 8, 16  # the fit minimises the 2p-norm of the gaps, p from 8 to 16
+_SAMPLES_PER_ARC = 24  # curve samples per arc the gaps are taken at (at least _MIN_SAMPLES)
+_MIN_SAMPLES = 512
+_TARGET = 0.95  # × tolerance: the sampled largest gap a refit must reach before it is measured
+_ITERATIONS = 80  # Levenberg–Marquardt steps per refit at most
+_STALL, _PROGRESS = 6, 0.1  # a refit stalls when its largest gap fell less than 10 % in 6 steps
+_RATIOS = np.array([0.5, 0.7, 1.0, 1.4, 2.0])  # d₁/d of the biarcs tried in place of three arcs
+_TRIES = 4  # failed drops in a row before thinning stops
+_LARGEST_LOOP = 96  # arcs: a longer loop is left as the search made it (dense Jacobian, O(n²) per step)
+
+
+def _rot(v: FloatArray) -> FloatArray:
+    """The vectors turned by +90°."""
+    return np.stack((-v[..., 1], v[..., 0]), axis=-1)
+
+
+@dataclass(frozen=True, slots=True)
+class _Loop:
+    """Chain x = (p₀, θ₀, κ…, s…) of n arcs: joints (n + 1, 2), tangent angles (n + 1,), dchord/dκ (n, 2)."""
+
+    x: FloatArray
+    n: int
+    p: FloatArray
+    th: FloatArray
+    dchord: FloatArray
+
+
+def _joints(x: FloatArray, n: int) -> _Loop:
+    """The chain's joints, tangent angles and each arc's chord vector's derivative by κ."""
+    k, s = x[3 : 3 + n], x[3 + n :]
+    half = 0.5 * k * s
+    th = x[2] + np.concatenate(([0.0], np.cumsum(k * s)))
+    mid = th[:-1] + half
+    small = np.abs(half) < 1e-4
+    hh = np.where(small, 1.0, half)
+    sinc = np.where(small, 1.0 - half * half / 6.0, np.sin(hh) / hh)
+    dsinc = np.where(small, -half / 3.0, (hh * np.cos(hh) - np.sin(hh)) / (hh * hh))
+    u = np.stack((np.cos(mid), np.sin(mid)), axis=1)
+    chord = (s * sinc)[:, None] * u
+    p = x[:2] + np.concatenate((np.zeros((1, 2)), np.cumsum(chord, axis=0)))
+    # d(chord)/dκ = (s²/2)·(sinc'(h) u + sinc(h) u⊥), h = κs/2
+    dchord = (0.5 * s * s)[:, None] * (dsinc[:, None] * u + sinc[:, None] * _rot(u))
+    return _Loop(x, n, p, th, dchord)
+
+
+def _assign(p: FloatArray, q: FloatArray) -> np.ndarray:
+    """Arc index of each curve sample: those from joint i's nearest sample to joint i + 1's are on arc i."""
+    n, m = p.shape[0] - 1, q.shape[0]
+    near = np.argmin(np.sum((q[None, :, :] - p[:-1, None, :]) ** 2, axis=2), axis=1)
+    rel = (near - near[0]) % m
+    order = np.argsort(rel, kind="stable")
+    seg = np.searchsorted(rel[order], (np.arange(m) - near[0]) % m, side="right") - 1
+    out: np.ndarray = order[np.clip(seg, 0, n - 1)]
+    return out
+
+
+def _gaps(
+    loop: _Loop, q: FloatArray, seg: np.ndarray, *, jacobian: bool = True
+) -> tuple[FloatArray, FloatArray | None]:
+    """Signed gaps (m,) [mm] of the samples from their arcs' circles, and (``jacobian``) dg/dx (m, 3 + 2n)."""
+    x, n, p, th, dchord = loop.x, loop.n, loop.p, loop.th, loop.dchord
+    k, s = x[3 : 3 + n], x[3 + n :]
+    pi, ti, ki = p[seg], th[seg], k[seg]
+    t = np.stack((np.cos(ti), np.sin(ti)), axis=1)
+    nl = _rot(t)
+    w = q - pi
+    b = np.sum(w * nl, axis=1)
+    ww = np.sum(w * w, axis=1)
+    f = ki * ww - 2.0 * b
+    root = np.sqrt(np.maximum(1.0 - 2.0 * ki * b + ki * ki * ww, 1e-300))
+    den = 1.0 + root
+    g = f / den
+    if not jacobian:
+        return g, None
+    # partial derivatives of g by the arc's start point, start angle and curvature
+    d_b_p, d_ww_p = -nl, -2.0 * w
+    d_b_th = -np.sum(w * t, axis=1)
+
+    d_f_p = ki[:, None] * d_ww_p - 2.0 * d_b_p
+    d_d_p = -2.0 * ki[:, None] * d_b_p + (ki * ki)[:, None] * d_ww_p
+    gp = (d_f_p - (g / (2.0 * root))[:, None] * d_d_p) / den[:, None]
+    gth = (-2.0 * d_b_th - (g / (2.0 * root)) * (-2.0 * ki * d_b_th)) / den
+    gk = (ww - (g / (2.0 * root)) * (-2.0 * b + 2.0 * ki * ww)) / den
+    # a change of κⱼ or sⱼ (j before the sample's arc) turns the loop after arc j about joint j + 1
+    rm = gth + cross(pi, gp)  # gθ + (pᵢ × gp)
+    turn = rm[:, None] - (gp[:, 1:2] * p[None, 1 : n + 1, 0] - gp[:, 0:1] * p[None, 1 : n + 1, 1])
+    before = np.arange(n)[None, :] < seg[:, None]
+    t_end = np.stack((np.cos(th[1:]), np.sin(th[1:])), axis=1)
+    jk = np.where(before, s[None, :] * turn + gp @ dchord.T, 0.0)
+    jk[np.arange(seg.size), seg] += gk
+    js = np.where(before, k[None, :] * turn + gp @ t_end.T, 0.0)
+    jac = np.concatenate((gp, (rm - cross(x[:2], gp))[:, None], jk, js), axis=1)
+    return g, jac
+
+
+def _closure(loop: _Loop, turn: float, c0: FloatArray, t0: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The four equations (closed in point and angle, start abeam C(a)) and their Jacobian (4, 3 + 2n)."""
+    x, n, p, th, dchord = loop.x, loop.n, loop.p, loop.th, loop.dchord
+    k, s = x[3 : 3 + n], x[3 + n :]
+    c = np.array([p[n, 0] - p[0, 0], p[n, 1] - p[0, 1], th[n] - th[0] - turn, float((p[0] - c0) @ t0)])
+    rel = _rot(p[n] - p[1:])  # J(pₙ − pⱼ₊₁)
+    t_end = np.stack((np.cos(th[1:]), np.sin(th[1:])), axis=1)
+    jac = np.zeros((4, 3 + 2 * n))
+    jac[0:2, 2] = _rot(p[n] - p[0])
+    jac[0:2, 3 : 3 + n] = (dchord + s[:, None] * rel).T
+    jac[0:2, 3 + n :] = (t_end + k[:, None] * rel).T
+    jac[2, 3 : 3 + n], jac[2, 3 + n :] = s, k
+    jac[3, 0:2] = t0
+    return c, jac
+
+
+def _onto(x: FloatArray, n: int, turn: float, c0: FloatArray, t0: FloatArray, steps: int) -> _Loop:
+    """The chain moved onto the four equations by up to ``steps`` least-change Newton steps."""
+    loop = _joints(x, n)
+    for _ in range(steps):
+        c, a = _closure(loop, turn, c0, t0)
+        if np.abs(c).max() <= 1e-12:
+            break
+        loop = _joints(loop.x - a.T @ np.linalg.solve(a @ a.T, c), n)
+    return loop
+
+
+def _minimax(
+    x: FloatArray, n: int, q: FloatArray, turn: float, c0: FloatArray, t0: FloatArray, target: float
+) -> tuple[FloatArray, float]:
+    """Levenberg–Marquardt on Σ (g/τ)^(2p) under the four equations: the best x and its largest gap [mm].
+
+    Returns as soon as the largest sampled gap is at most ``target``; the
+    equations hold to 1e-9 mm (and rad) at every returned x. When the gap
+    falls less than ``_PROGRESS`` in ``_STALL`` steps, p doubles (up to
+    ``_POWER_MAX``: the norm nears the maximum), and then the refit stops.
+    """
+    size = x.size
+    loop = _onto(x, n, turn, c0, t0, 8)  # a dropped arc leaves the loop open by millimetres
+    seg = _assign(loop.p, q)
+    g, jac = _gaps(loop, q, seg)
+    c, a = _closure(loop, turn, c0, t0)
+    best = (math.inf, loop.x)
+    lam, power = 1e-3, _POWER
+    seen: list[float] = []
+    for _ in range(_ITERATIONS):
+        tau = float(np.abs(g).max())
+        if np.abs(c).max() <= 1e-9 and tau < best[0]:
+            best = (tau, loop.x)
+            if tau <= target:
+                break
+        seen.append(tau)
+        if len(seen) > _STALL and tau > (1.0 - _PROGRESS) * seen[-1 - _STALL]:
+            if power >= _POWER_MAX:
+                break  # stalled above the target: this arc count does not fit here
+            power, seen = 2 * power, []
+        assert jac is not None
+        u = g / tau
+        r = u**power
+        jr = (power * u ** (power - 1) / tau)[:, None] * jac
+        h, grad = jr.T @ jr, jr.T @ r
+        f0 = float(r @ r)
+        kkt = np.zeros((size + 4, size + 4))
+        kkt[:size, size:], kkt[size:, :size] = a.T, a
+        rhs = np.concatenate((-grad, -c))
+        diag = np.diag(h) + 1e-12
+        while True:
+            kkt[:size, :size] = h
+            kkt[np.arange(size), np.arange(size)] += lam * diag
+            try:
+                step = np.linalg.solve(kkt, rhs)[:size]
+            except np.linalg.LinAlgError:
+                step = None
+            if step is not None:
+                found = None
+                for stretch in _STRETCH:
+                    cand = _onto(loop.x + stretch * step, n, turn, c0, t0, 1)  # nearly linear over a step
+                    # the trial keeps the samples' arcs; they are assigned again once it is taken
+                    gn, _ = _gaps(cand, q, seg, jacobian=False)
+                    fn = float(np.sum((gn / tau) ** (2 * power))) if np.all(np.isfinite(gn)) else math.inf
+                    if fn < f0 and (found is None or fn < found[0]):
+                        found = (fn, cand)
+                    elif found is not None:
+                        break
+                if found is not None:
+                    trial = found[1]
+                    break
+            lam *= 8.0
+            if lam > 1e6:
+                return best[1], best[0]
+        loop = trial
+        seg = _assign(loop.p, q)
+        g, jac = _gaps(loop, q, seg)
+        c, a = _closure(loop, turn, c0, t0)
+        lam = max(lam / 4.0, 1e-9)
+    tau = float(np.abs(g).max())
+    if np.abs(c).max() <= 1e-9 and tau < best[0]:
+        best = (tau, loop.x)
+    return best[1], best[0]
+
+
+def _chain(pieces: Pieces) -> tuple[FloatArray, int]:
+    """The chain x = (p₀, θ₀, κ…, s…) of the non-empty pieces in order (arcs and lines), and its length."""
+    sweep = pieces.sweep()
+    moves = np.any(pieces.start != pieces.end, axis=-1)
+    keep = np.flatnonzero(((sweep != 0.0) | (pieces.line & moves)).ravel())
+    start = pieces.start.reshape(-1, 2)[keep]
+    end = pieces.end.reshape(-1, 2)[keep]
+    center = pieces.center.reshape(-1, 2)[keep]
+    line = pieces.line.ravel()[keep]
+    ccw = pieces.ccw.ravel()[keep]
+    radius = pieces.r_start.ravel()[keep]
+    side = np.where(ccw, 1.0, -1.0)
+    k = np.where(line, 0.0, side / np.where(line, 1.0, radius))
+    s = np.where(line, np.linalg.norm(end - start, axis=1), np.abs(sweep.ravel()[keep]) * radius)
+    radial = start - center
+    t0 = end[0] - start[0] if line[0] else side[0] * _rot(radial[0])
+    return np.concatenate((start[0], [float(angle_of(t0[None])[0])], k, s)), int(keep.size)
+
+
+def _pieces(curve: CurveFn, x: FloatArray, n: int, a: float, q: FloatArray, phi_q: FloatArray) -> Pieces:
+    """The loop's arcs as pieces, their φ-intervals from a to a + 2π between the joints abeam on the curve."""
+    loop = _joints(x, n)
+    p, th = loop.p, loop.th
+    near = np.argmin(np.sum((q[None, :, :] - p[1:n, None, :]) ** 2, axis=2), axis=1)
+    at, _ = abeam(curve, p[1:n], phi_q[near])
+    edges = np.concatenate(([a], at, [a + 2.0 * math.pi]))
+    t = np.stack((np.cos(th[:-1]), np.sin(th[:-1])), axis=1)
+    end = p[1:].copy()
+    end[-1] = p[0]
+    return single_arcs(edges[:-1], edges[1:], p[:-1], t, end)
+
+
+def _drop(x: FloatArray, n: int, i: int) -> FloatArray:
+    """The chain without arc i, half its length given to each neighbour (a first guess for a refit)."""
+    k, s = x[3 : 3 + n].copy(), x[3 + n :].copy()
+    if i == 0:  # the loop then starts halfway along the old first arc
+        half = _joints(np.concatenate((x[:3], k[:1], 0.5 * s[:1])), 1)
+        p, th = half.p, half.th
+        head = np.concatenate((p[1], th[1:2]))
+        s[1] += 0.5 * s[0]
+        s[n - 1] += 0.5 * s[0]
+        return np.concatenate((head, k[1:], s[1:]))
+    s[i - 1] += 0.5 * s[i]
+    s[(i + 1) % n] += 0.5 * s[i]
+    return np.concatenate((x[:3], np.delete(k, i), np.delete(s, i)))
+
+
+def _signed_turn(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Signed angle [rad] from unit vectors a to b, in (−π, π]."""
+    return np.arctan2(cross(a, b), np.sum(a * b, axis=-1))
+
+
+def _merges(x: FloatArray, n: int) -> tuple[np.ndarray, FloatArray]:
+    """For each arc 0 < i < n − 1: the chain with arcs i − 1, i, i + 1 replaced by a biarc.
+
+    The biarc runs between the joints around the three arcs with their
+    tangents (so the rest of the loop is unchanged and it stays closed), its
+    d₁/d each of ``_RATIOS`` (Bolton's equal-chord biarc at 1). Returns the
+    arc index of each guess (k,) and the guesses (k, 3 + 2(n − 1)).
+    """
+    loop = _joints(x, n)
+    p, th = loop.p, loop.th
+    k, s = x[3 : 3 + n], x[3 + n :]
+    i = np.repeat(np.arange(1, n - 1), _RATIOS.size)
+    ratio = np.tile(_RATIOS, n - 2)
+    p0, p1 = p[i - 1], p[i + 2]
+    t0 = np.stack((np.cos(th[i - 1]), np.sin(th[i - 1])), axis=1)
+    t1 = np.stack((np.cos(th[i + 2]), np.sin(th[i + 2])), axis=1)
+    v = p1 - p0
+    vt, vv, c = np.sum(v * (t0 + t1), axis=1), np.sum(v * v, axis=1), 1.0 - np.sum(t0 * t1, axis=1)
+    d = vv / (vt + np.sqrt(np.maximum(vt * vt + 2.0 * c * vv, 0.0)))  # Bolton 1975, as in biarc_pieces
+    d1 = d * ratio
+    d2 = (vv - 2.0 * d1 * np.sum(v * t0, axis=1)) / (2.0 * (np.sum(v * t1, axis=1) + d1 * c))
+    q0, q1 = p0 + d1[:, None] * t0, p1 - d2[:, None] * t1
+    joint = q0 + (d1 / (d1 + d2))[:, None] * (q1 - q0)
+    tm = (q1 - q0) / np.linalg.norm(q1 - q0, axis=1)[:, None]
+
+    def arc(a: FloatArray, ta: FloatArray, b: FloatArray, tb: FloatArray) -> tuple[FloatArray, FloatArray]:
+        turn = _signed_turn(ta, tb)
+        chord = np.linalg.norm(b - a, axis=1)
+        half = 0.5 * turn
+        length = chord * np.where(np.abs(half) < 1e-8, 1.0, half / np.where(half == 0.0, 1.0, np.sin(half)))
+        return turn / length, length
+
+    ka, sa = arc(p0, t0, joint, tm)
+    kb, sb = arc(joint, tm, p1, t1)
+    ok = (d1 > 0.0) & (d2 > 0.0) & np.isfinite(ka + kb + sa + sb)
+    out = np.empty((i.size, 3 + 2 * (n - 1)))
+    out[:, :3] = x[:3]
+    for row in np.flatnonzero(ok):
+        j = i[row]
+        kk = np.concatenate((k[: j - 1], [ka[row], kb[row]], k[j + 2 :]))
+        ss = np.concatenate((s[: j - 1], [sa[row], sb[row]], s[j + 2 :]))
+        out[row, 3:] = np.concatenate((kk, ss))
+    return i[ok], out[ok]
+
+
+def thin_loop(curve: CurveFn, pieces: Pieces, tolerance: float, a: float) -> tuple[Pieces, FloatArray] | None:
+    """A closed arc spline with fewer arcs than ``pieces`` within ``tolerance`` [mm] of the curve, or None.
+
+    Parameters
+    ----------
+    curve
+        The exact closed curve C(φ), C(φ + 2π) = C(φ).
+    pieces
+        A closed tangent-continuous arc spline within ``tolerance`` (the
+        search's), its φ-intervals from its start to the same φ + 2π.
+    tolerance
+        Two-way deviation allowed [mm].
+    a
+        φ [rad] the loop starts abeam of.
+
+    Returns
+    -------
+    (Pieces, FloatArray) or None
+        Single arcs (an empty second piece each) whose φ-intervals run from a
+        to a + 2π, starting abeam C(a), and their measured two-way deviations;
+        None when no arc could be dropped.
+    """
+    x, n = _chain(pieces)
+    if n < 4 or n > _LARGEST_LOOP:
+        return None
+    turn = 2.0 * math.pi * round(float(np.sum(x[3 : 3 + n] * x[3 + n :])) / (2.0 * math.pi))
+    m = max(_MIN_SAMPLES, _SAMPLES_PER_ARC * n)
+    phi_q = a + 2.0 * math.pi * (np.arange(m) + 0.5) / m
+    q = curve(phi_q)[0]
+    c0, d0, _ = curve(np.array([a]))
+    c0, t0 = c0[0], d0[0] / np.linalg.norm(d0[0])
+    out: tuple[Pieces, FloatArray] | None = None
+    tried = 0
+    while tried < _TRIES and n > 3:
+        which, guesses = _merges(x, n)
+        which = np.concatenate((which, [0, n - 1]))
+        guesses = np.concatenate((guesses, [_drop(x, n, 0), _drop(x, n, n - 1)]))
+        loops = [_joints(gx, n - 1) for gx in guesses]
+        first = np.array([np.abs(_gaps(lp, q, _assign(lp.p, q), jacobian=False)[0]).max() for lp in loops])
+        order = np.argsort(first, kind="stable")
+        _, pick = np.unique(which[order], return_index=True)  # each arc's best guess
+        pick = order[np.sort(pick)]
+        pick = pick[np.argsort(first[pick], kind="stable")]  # guesses nearest the curve first
+        for guess in guesses[pick[:_TRIES]]:
+            fit, gap = _minimax(guess, n - 1, q, turn, c0, t0, _TARGET * tolerance)
+            tried += 1
+            if gap > _TARGET * tolerance:
+                continue
+            pc = _pieces(curve, fit, n - 1, a, q, phi_q)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                dev = measure_deviation(curve, pc)
+            if np.all(np.diff(pc.lo) > 0.0) and np.all(dev <= tolerance):
+                x, n, out, tried = fit, n - 1, (pc, dev), 0
+                break
+        else:
+            break
+    return out
