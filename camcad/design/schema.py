@@ -918,6 +918,10 @@ def _check_gcode(design: Design) -> None:
         raise DesignError(
             field, "the rotary program cuts the profile only: no tabs, no bore (allowed: 0 and false)"
         )
+    if gc.machine is Machine.ROTARY and gc.fewest_arcs:
+        raise DesignError(
+            "gcode.fewest_arcs", "the rotary program has no XY arcs to refit (allowed: false; xy only)"
+        )
     if gc.safe_height >= gc.clearance_height:
         raise DesignError(
             "gcode.safe_height",

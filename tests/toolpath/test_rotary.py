@@ -314,6 +314,7 @@ def test_grbl_cannot_run_a_rotary_program():
         ({"machine": "rotary", "rotary_axis": "B"}, "gcode.rotary_axis"),
         ({"machine": "rotary", "tab_count": 2}, "gcode.tab_count"),
         ({"machine": "rotary", "mill_bore": True}, "gcode.mill_bore"),
+        ({"machine": "rotary", "fewest_arcs": True}, "gcode.fewest_arcs"),
         ({"machine": "lathe"}, "gcode.machine"),
         ({"machine": "rotary", "dialect": "grbl"}, "gcode.dialect"),
     ],

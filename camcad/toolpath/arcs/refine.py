@@ -14,8 +14,10 @@ starts abeam C(a) when (p₀ − C(a))·T(a) = 0. The fit minimises the largest
 normal gap of curve samples from the circle of the arc each sample lies
 along (between the nearest samples of its two joints). The largest gap is
 not smooth, so Levenberg–Marquardt minimises Σ (g/τ)^(2p) with τ the current
-largest gap and p = 8 (the 16-norm, within a few per cent of the maximum
-once the gaps equioscillate), the four equations held by the KKT system,
+largest gap and p = 8 (the 16-norm), then 16 once that stalls (Marquardt
+1963, with his scaling of the damping by the diagonal; the step is that of
+Gauss–Newton on (g/τ)^p, tried also at twice its length), the four
+equations held by the KKT system,
 with the Jacobian by hand (a change of κⱼ or sⱼ moves the loop after arc j
 rigidly: a turn about joint j + 1). It is hand-written because
 ``scipy.optimize`` costs 0.3 s to import in a build that otherwise needs
@@ -28,9 +30,9 @@ length to each neighbour), refits the candidates whose guess starts nearest
 the curve, and keeps the first whose two-way deviation, measured by
 :func:`~camcad.toolpath.arcs.biarc.measure_deviation`, is within the
 tolerance; it stops after ``_TRIES`` failed refits in a row. It runs only
-when asked (``[gcode] fewest_arcs``): it drops 1–4 arcs on every shipped
-sample (every loop within 1.2 times the asymptotic fewest arcs) at 0.3–0.8 s
-more per contour.
+when asked (``[gcode] fewest_arcs``): on the shipped samples it drops 1–2
+arcs on eight of twelve (every loop then within 1.2 times the asymptotic
+fewest arcs of ``benchmarks/gcode.py``) for 0.2–0.5 s more per contour.
 """
 
 from __future__ import annotations
@@ -390,7 +392,7 @@ def thin_loop(curve: CurveFn, pieces: Pieces, tolerance: float, a: float) -> tup
             pc = _pieces(curve, fit, n - 1, a, q, phi_q)
             with np.errstate(invalid="ignore", divide="ignore"):
                 dev = measure_deviation(curve, pc)
-            if np.all(np.diff(pc.lo) > 0.0) and np.all(dev <= tolerance):
+            if np.all(pc.hi > pc.lo) and np.all(dev <= tolerance):
                 x, n, out, tried = fit, n - 1, (pc, dev), 0
                 break
         else:
