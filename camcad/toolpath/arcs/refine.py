@@ -54,6 +54,7 @@ _MIN_SAMPLES = 512
 _TARGET = 0.95  # × tolerance: the sampled largest gap a refit must reach before it is measured
 _ITERATIONS = 80  # Levenberg–Marquardt steps per refit at most
 _STALL, _PROGRESS = 6, 0.1  # a refit stalls when its largest gap fell less than 10 % in 6 steps
+_WINDOW = 6  # samples either side of a joint's last nearest sample searched for its next
 _RATIOS = np.array([0.5, 0.7, 1.0, 1.4, 2.0])  # d₁/d of the biarcs tried in place of three arcs
 _TRIES = 4  # failed drops in a row before thinning stops
 _LARGEST_LOOP = 96  # arcs: a longer loop is left as the search made it (dense Jacobian, O(n²) per step)
@@ -93,15 +94,28 @@ def _joints(x: FloatArray, n: int) -> _Loop:
     return _Loop(x, n, p, th, dchord)
 
 
-def _assign(p: FloatArray, q: FloatArray) -> np.ndarray:
-    """Arc index of each curve sample: those from joint i's nearest sample to joint i + 1's are on arc i."""
+def _assign(p: FloatArray, q: FloatArray, near: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Arc index of each curve sample (those from joint i's nearest sample to joint i + 1's are on arc i).
+
+    Also returns each joint's nearest sample; given last step's (``near``),
+    only ``_WINDOW`` samples either side are searched, and all where the
+    nearest is at a window's edge.
+    """
     n, m = p.shape[0] - 1, q.shape[0]
-    near = np.argmin(np.sum((q[None, :, :] - p[:-1, None, :]) ** 2, axis=2), axis=1)
-    rel = (near - near[0]) % m
+    if near is None:
+        found = np.argmin(np.sum((q[None, :, :] - p[:-1, None, :]) ** 2, axis=2), axis=1)
+    else:
+        idx = (near[:, None] + np.arange(-_WINDOW, _WINDOW + 1)[None, :]) % m
+        best = np.argmin(np.sum((q[idx] - p[:-1, None, :]) ** 2, axis=2), axis=1)
+        found = idx[np.arange(n), best]
+        edge = (best == 0) | (best == 2 * _WINDOW)
+        if edge.any():
+            found[edge] = np.argmin(np.sum((q[None, :, :] - p[:-1][edge][:, None, :]) ** 2, axis=2), axis=1)
+    rel = (found - found[0]) % m
     order = np.argsort(rel, kind="stable")
-    seg = np.searchsorted(rel[order], (np.arange(m) - near[0]) % m, side="right") - 1
+    seg = np.searchsorted(rel[order], (np.arange(m) - found[0]) % m, side="right") - 1
     out: np.ndarray = order[np.clip(seg, 0, n - 1)]
-    return out
+    return out, found
 
 
 def _gaps(
@@ -182,7 +196,7 @@ def _minimax(
     """
     size = x.size
     loop = _onto(x, n, turn, c0, t0, 8)  # a dropped arc leaves the loop open by millimetres
-    seg = _assign(loop.p, q)
+    seg, near = _assign(loop.p, q)
     g, jac = _gaps(loop, q, seg)
     c, a = _closure(loop, turn, c0, t0)
     best = (math.inf, loop.x)
@@ -234,7 +248,7 @@ def _minimax(
             if lam > 1e6:
                 return best[1], best[0]
         loop = trial
-        seg = _assign(loop.p, q)
+        seg, near = _assign(loop.p, q, near)
         g, jac = _gaps(loop, q, seg)
         c, a = _closure(loop, turn, c0, t0)
         lam = max(lam / 4.0, 1e-9)
@@ -296,13 +310,16 @@ def _signed_turn(a: FloatArray, b: FloatArray) -> FloatArray:
     return np.arctan2(cross(a, b), np.sum(a * b, axis=-1))
 
 
-def _merges(x: FloatArray, n: int) -> tuple[np.ndarray, FloatArray]:
+def _merges(
+    x: FloatArray, n: int, q: FloatArray, seg: np.ndarray
+) -> tuple[np.ndarray, FloatArray, FloatArray]:
     """For each arc 0 < i < n − 1: the chain with arcs i − 1, i, i + 1 replaced by a biarc.
 
     The biarc runs between the joints around the three arcs with their
     tangents (so the rest of the loop is unchanged and it stays closed), its
     d₁/d each of ``_RATIOS`` (Bolton's equal-chord biarc at 1). Returns the
-    arc index of each guess (k,) and the guesses (k, 3 + 2(n − 1)).
+    arc index of each guess (k,), the guesses (k, 3 + 2(n − 1)) and each
+    guess's largest gap [mm] on the samples ``seg`` puts on the three arcs.
     """
     loop = _joints(x, n)
     p, th = loop.p, loop.th
@@ -338,7 +355,24 @@ def _merges(x: FloatArray, n: int) -> tuple[np.ndarray, FloatArray]:
         kk = np.concatenate((k[: j - 1], [ka[row], kb[row]], k[j + 2 :]))
         ss = np.concatenate((s[: j - 1], [sa[row], sb[row]], s[j + 2 :]))
         out[row, 3:] = np.concatenate((kk, ss))
-    return i[ok], out[ok]
+    # the largest gap of each guess: the rest of the loop is unchanged, so only the samples of the
+    # three arcs count, each measured from the biarc's arc it lies along (split at the joint's normal)
+    first = np.searchsorted(seg, np.arange(n + 1))  # seg is sorted (from the start joint's sample on)
+    lo, hi = first[i - 1], first[i + 2]
+    width = int((hi - lo).max())
+    idx = lo[:, None] + np.arange(width)[None, :]
+    inside = idx < hi[:, None]
+    w = q[np.minimum(idx, q.shape[0] - 1)]
+    second = np.sum((w - joint[:, None, :]) * tm[:, None, :], axis=2) > 0.0
+    start = np.where(second[..., None], joint[:, None, :], p0[:, None, :])
+    tang = np.where(second[..., None], tm[:, None, :], t0[:, None, :])
+    kap = np.where(second, kb[:, None], ka[:, None])
+    v = w - start
+    b = cross(tang, v)
+    vv = np.sum(v * v, axis=2)
+    gap = (kap * vv - 2.0 * b) / (1.0 + np.sqrt(np.maximum(1.0 - 2.0 * kap * b + kap * kap * vv, 0.0)))
+    worst = np.where(inside, np.abs(gap), 0.0).max(axis=1)
+    return i[ok], out[ok], worst[ok]
 
 
 def thin_loop(curve: CurveFn, pieces: Pieces, tolerance: float, a: float) -> tuple[Pieces, FloatArray] | None:
@@ -375,11 +409,15 @@ def thin_loop(curve: CurveFn, pieces: Pieces, tolerance: float, a: float) -> tup
     out: tuple[Pieces, FloatArray] | None = None
     tried = 0
     while tried < _TRIES and n > 3:
-        which, guesses = _merges(x, n)
+        seg, near = _assign(_joints(x, n).p, q)
+        # the samples from the start joint's nearest on, so that their arc indices are sorted
+        which, guesses, first = _merges(x, n, np.roll(q, -near[0], axis=0), np.roll(seg, -near[0]))
+        ends = [_drop(x, n, 0), _drop(x, n, n - 1)]
+        loops = [_joints(gx, n - 1) for gx in ends]
+        gaps = [_gaps(lp, q, _assign(lp.p, q)[0], jacobian=False)[0] for lp in loops]
+        first = np.concatenate((first, [float(np.abs(g).max()) for g in gaps]))
         which = np.concatenate((which, [0, n - 1]))
-        guesses = np.concatenate((guesses, [_drop(x, n, 0), _drop(x, n, n - 1)]))
-        loops = [_joints(gx, n - 1) for gx in guesses]
-        first = np.array([np.abs(_gaps(lp, q, _assign(lp.p, q), jacobian=False)[0]).max() for lp in loops])
+        guesses = np.concatenate((guesses, ends))
         order = np.argsort(first, kind="stable")
         _, pick = np.unique(which[order], return_index=True)  # each arc's best guess
         pick = order[np.sort(pick)]
