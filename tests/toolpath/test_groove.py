@@ -247,6 +247,18 @@ def test_sample_groove_program_is_proved_on_the_exact_flanks():
     assert tp.levels == (-3.0, -6.0, -9.0, -12.0)  # 12 mm deep at step_down 3: four laps of 3 mm
 
 
+def test_fewest_arcs_groove_program_is_proved_on_the_exact_flanks_with_fewer_arcs():
+    """[gcode] fewest_arcs refits the centre line: fewer arcs, and the same proof on the flanks."""
+    design, _, _ = sample()
+    design = replace(design, gcode=replace(design.gcode, start_angle=0.6))  # rad: one arc fewer from here
+    _, plain = plan(design)
+    design = replace(design, gcode=replace(design.gcode, fewest_arcs=True))
+    cam, tp = plan(design)
+    assert tp.contour_arcs < plain.contour_arcs
+    assert_proved(prove(parse_gcode(render_gcode(tp)), cam, design), cam, design)
+    assert tp.max_deviation <= design.gcode.tolerance
+
+
 def test_conventional_puts_both_flanks_on_the_left():
     """The direction is not hard-wired: conventional milling reverses both finishing passes."""
     design = load_design(SAMPLE)
