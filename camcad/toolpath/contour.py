@@ -234,7 +234,7 @@ def fit_contour(
     clockwise: bool,
     windows: Sequence[tuple[float, float]] = (),
     arcs: bool = True,
-    thin: bool = False,
+    fewest_arcs: bool = False,
 ) -> Contour:
     """Fit, orient, round and measure the closed path ``cam.offset(phi, distance)``.
 
@@ -256,7 +256,7 @@ def fit_contour(
         (:meth:`Contour.tabbed_steps`); the fit ignores them.
     arcs
         False for G1 chords only.
-    thin
+    fewest_arcs
         Refit the closed arc spline with fewer arcs where the tolerance
         allows (``[gcode] fewest_arcs``).
 
@@ -272,7 +272,9 @@ def fit_contour(
     """
     curve = offset_curve(cam, distance)
     try:
-        pieces, _ = fit_arc_spline(curve, breaks, fit_tol, arcs=arcs, closed=breaks.size == 2, thin=thin)
+        pieces, _ = fit_arc_spline(
+            curve, breaks, fit_tol, arcs=arcs, closed=breaks.size == 2, fewest_arcs=fewest_arcs
+        )
     except ValueError as err:  # pragma: no cover - only for a cusp the gouge check missed
         raise DesignLimitError(f"cannot fit the toolpath: {err}") from err
     return _realise(cam, distance, pieces, breaks, tol, clockwise=clockwise, windows=windows)

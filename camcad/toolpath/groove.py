@@ -191,7 +191,9 @@ def plan_groove(
     phi0 = float(spec.start_angle) % TWO_PI
     breaks = _breaks(cam, phi0)
     climb = spec.direction is Direction.CLIMB
-    centre = fit_contour(cam, cam.roller_radius, breaks, tol, fit_tol, clockwise=True, thin=spec.fewest_arcs)
+    centre = fit_contour(
+        cam, cam.roller_radius, breaks, tol, fit_tol, clockwise=True, fewest_arcs=spec.fewest_arcs
+    )
     inner_at, outer_at = groove.inner_offset + r, groove.outer_offset - r
     # the flank paths: the centre line's arc spline offset (arcs stay arcs), measured, refitted if out
     inner = offset_contour(cam, centre, inner_at, breaks, tol, fit_tol, clockwise=climb)

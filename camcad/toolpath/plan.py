@@ -355,8 +355,9 @@ def _fit_contours(
     breaks = _breaks(cam, phi0)
     clockwise = spec.direction is Direction.CLIMB
     finish = fit_contour(
-        cam, r, breaks, tol, fit_tol, clockwise=clockwise, windows=windows, arcs=arcs, thin=spec.fewest_arcs
-    )
+        cam, r, breaks, tol, fit_tol,
+        clockwise=clockwise, windows=windows, arcs=arcs, fewest_arcs=spec.fewest_arcs,
+    )  # fmt: skip
     if stock > 0.0 and arcs:
         # the finishing arc spline offset by the stock (arcs stay arcs), measured; refitted if it misses
         rough = offset_contour(

@@ -477,10 +477,10 @@ def harmonic_finish():
 
 
 def test_a_thinned_loop_has_fewer_arcs_is_one_g1_loop_in_tolerance_and_starts_abeam_its_start():
-    """thin=True: arcs dropped by the minimax refit; a dense two-way check, closure and tangents."""
+    """fewest_arcs=True: arcs dropped by the minimax refit; a dense two-way check, closure and tangents."""
     curve, tol = harmonic_finish()
     searched, _ = fit_arc_spline(curve, [0.0, 2 * np.pi], tol, closed=True)
-    pieces, dev = fit_arc_spline(curve, [0.0, 2 * np.pi], tol, closed=True, thin=True)
+    pieces, dev = fit_arc_spline(curve, [0.0, 2 * np.pi], tol, closed=True, fewest_arcs=True)
     assert arc_count(pieces) <= arc_count(searched) - 1
     assert dev.max() <= tol
     assert_two_way_within(curve, pieces, tol)

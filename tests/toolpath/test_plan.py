@@ -139,7 +139,7 @@ def test_fewest_arcs_drops_arcs_and_starts_the_contour_abeam_the_start_angle():
 
     r, tol, phi = design.gcode.tool_radius, design.gcode.tolerance, math.radians(40.0)
     finish = contour.fit_contour(
-        cam, r, _breaks(cam, phi), tol, _fit_tolerance(tol), clockwise=True, thin=True
+        cam, r, _breaks(cam, phi), tol, _fit_tolerance(tol), clockwise=True, fewest_arcs=True
     )
     point, d1, _ = contour.offset_curve(cam, r)(np.array([phi]))
     assert abs((np.asarray(finish.start) - point[0]) @ (d1[0] / np.linalg.norm(d1[0]))) <= 1e-4

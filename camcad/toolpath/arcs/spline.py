@@ -36,7 +36,7 @@ def fit_arc_spline(
     *,
     arcs: bool = True,
     closed: bool = False,
-    thin: bool = False,
+    fewest_arcs: bool = False,
 ) -> tuple[Pieces, FloatArray]:
     """Fit a tangent-continuous arc spline (or chords) to C(φ) between sorted φ-breaks within a tolerance.
 
@@ -58,7 +58,7 @@ def fit_arc_spline(
         path starts within the band near C(a) instead of on it (one arc
         fewer than a closing biarc); the pieces' φ-intervals then run from
         the start's φ to the same φ + 2π.
-    thin
+    fewest_arcs
         With ``closed``: refit the loop with fewer arcs where the measured
         deviation allows (:func:`~camcad.toolpath.arcs.refine.thin_loop`);
         the loop then starts abeam C(a).
@@ -101,9 +101,9 @@ def fit_arc_spline(
         return march_arcs(curve, edges, tolerance, arcs=False)
     parts: list[Pieces] = []
     devs: list[FloatArray] = []
+    loop = closed and edges.size == 2
     for a, b in itertools.pairwise(edges):
         try:
-            loop = closed and edges.size == 2
             done, dev = search_arcs(curve, float(a), float(b), tolerance, closed=loop)
         except ArcSearchStallError:
             fallback, fdev = march_arcs(curve, np.array([a, b]), tolerance, arcs=True)
@@ -112,7 +112,7 @@ def fit_arc_spline(
         devs += dev
     out = concat_pieces(parts)
     dev_all = np.concatenate(devs)[np.argsort(np.concatenate([p.lo for p in parts]), kind="stable")]
-    if thin and closed and edges.size == 2 and (fewer := thin_loop(curve, out, tolerance, float(edges[0]))):
+    if fewest_arcs and loop and (fewer := thin_loop(curve, out, tolerance, float(edges[0]))):
         out, dev_all = fewer
     readonly(dev_all)
     return out, dev_all
