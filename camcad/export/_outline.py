@@ -34,6 +34,7 @@ __all__ = [
     "bspline_length",
     "flatten_bspline",
     "flatten_curve",
+    "knot_spans",
     "oriented",
     "polygon_area",
     "polygon_perimeter",
@@ -72,7 +73,7 @@ def oriented(points: FloatArray, *, ccw: bool) -> FloatArray:
     return points
 
 
-def _span_starts(curve: BSplineCurve) -> tuple[FloatArray, FloatArray]:
+def knot_spans(curve: BSplineCurve) -> tuple[FloatArray, FloatArray]:
     """Start and end parameter of every non-empty knot span inside the domain."""
     a, b = curve.domain
     breaks = np.unique(curve.knots[(curve.knots >= a) & (curve.knots <= b)])
@@ -114,14 +115,13 @@ def flatten_bspline(curve: BSplineCurve, chord_tolerance: float) -> FloatArray:
         raise ValueError(f"flatten_bspline supports degree ≤ 3, got {curve.degree}")
     if chord_tolerance <= 0.0:
         raise ValueError(f"chord_tolerance must be > 0, got {chord_tolerance!r}")
-    start, end = _span_starts(curve)
+    start, end = knot_spans(curve)
     h = end - start
     if curve.degree < 2:
         counts = np.ones(start.size, dtype=int)
     else:
         # C'' is linear on the span: extrapolate its end values from two interior points.
-        q1 = curve.evaluate(start + 0.25 * h, 2)
-        q3 = curve.evaluate(start + 0.75 * h, 2)
+        q1, q3 = np.split(curve.evaluate(np.concatenate((start + 0.25 * h, start + 0.75 * h)), 2), 2)
         at_start = 1.5 * q1 - 0.5 * q3
         at_end = 1.5 * q3 - 0.5 * q1
         bound = np.maximum(np.linalg.norm(at_start, axis=1), np.linalg.norm(at_end, axis=1))
@@ -161,7 +161,7 @@ def bspline_area(curve: BSplineCurve) -> float:
     p-point Gauss-Legendre integrates exactly, so the result is exact up to
     round-off.
     """
-    start, end = _span_starts(curve)
+    start, end = knot_spans(curve)
     u, weight = _gauss_legendre(start, end, max(curve.degree, 1) + 1)
     p, d = curve_derivatives(curve, u, 1)
     return 0.5 * float(np.sum(weight * (p[:, 0] * d[:, 1] - p[:, 1] * d[:, 0])))
@@ -169,7 +169,7 @@ def bspline_area(curve: BSplineCurve) -> float:
 
 def bspline_length(curve: BSplineCurve, *, nodes: int = 12) -> float:
     """Arc length of a B-spline [mm], by ``nodes``-point Gauss-Legendre on each knot span."""
-    start, end = _span_starts(curve)
+    start, end = knot_spans(curve)
     u, weight = _gauss_legendre(start, end, nodes)
     d = curve.evaluate(u, 1)
     return float(np.sum(weight * np.linalg.norm(d, axis=1)))

@@ -43,6 +43,7 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.errors import ExportError
+from camcad.export._outline import knot_spans, polygon_area
 from camcad.fit.curve import BSplineCurve
 from camcad.geometry.plate import BoreOutline
 
@@ -184,17 +185,10 @@ def _polygon(outline: Outline) -> FloatArray:
     """(n, 2) points of the outline in its own direction [mm], for the nesting tests."""
     if isinstance(outline, BoreOutline):
         return outline.polygon(CIRCLE_CHORD * outline.radius)
-    lo, hi = outline.domain
-    breaks = np.unique(outline.knots[(outline.knots >= lo) & (outline.knots <= hi)])
+    start, end = knot_spans(outline)
     fraction = np.arange(SAMPLES_PER_SPAN) / SAMPLES_PER_SPAN
-    u = (breaks[:-1, None] + (breaks[1:] - breaks[:-1])[:, None] * fraction).ravel()
+    u = (start[:, None] + (end - start)[:, None] * fraction).ravel()
     return np.asarray(outline.evaluate(u), dtype=float)
-
-
-def _signed_area(polygon: FloatArray) -> float:
-    """Shoelace area [mm²]: > 0 when the polygon runs counter-clockwise."""
-    x, y = polygon[:, 0], polygon[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
 
 
 def _inside(polygon: FloatArray, points: FloatArray) -> np.ndarray:
@@ -229,7 +223,7 @@ def _loop(
     name: str, label: str, outline: Outline, z_low: float, z_top: float, inside: bool, cut: int
 ) -> _Loop:
     polygon = _polygon(outline)
-    area = _signed_area(polygon)
+    area = polygon_area(polygon)
     if not area != 0.0:
         raise ExportError(f"{name}: {label} encloses no area")
     return _Loop(label, outline, z_low, z_top, inside, polygon, area > 0.0, cut)
@@ -363,8 +357,8 @@ def _bspline(data: Entities, curve: BSplineCurve, z: float) -> str:
         drop = int(np.count_nonzero(knots == lo)) - 1
         ctrl, knots = ctrl[drop:], knots[drop:]
     written = BSplineCurve(degree=p, knots=knots, control_points=ctrl)
-    breaks = np.unique(knots[(knots >= lo) & (knots <= hi)])
-    u = np.concatenate(([lo, hi], 0.5 * (breaks[:-1] + breaks[1:])))
+    start, end = knot_spans(curve)
+    u = np.concatenate(([lo, hi], 0.5 * (start + end)))
     got = written.evaluate(u)
     size = float(np.max(np.abs(ctrl)))
     if not (

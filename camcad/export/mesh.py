@@ -406,6 +406,7 @@ def build_groove_solid(
 # ---------------------------------------------------------------------------
 # writers
 
+
 def _write_vtu(tmp: Path, mesh: TriangleMesh) -> None:
     import meshio  # here: only the VTU format needs it
 

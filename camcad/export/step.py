@@ -64,6 +64,7 @@ LINE_WIDTH = 80  # physical lines of the exchange structure are folded after a c
 SCHEMA = "AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }"  # AP214 IS
 UNCERTAINTY_MM = 1e-7
 
+
 def plate_body(fit: ProfileFit, plate: Plate) -> Body:
     """The cam plate: the fit's periodic B-spline extruded by the plate thickness, minus bore and keyway."""
     if not fit.curve.periodic:

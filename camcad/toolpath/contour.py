@@ -356,15 +356,7 @@ def _realise(
 
 def _end_tangents(pieces: Pieces) -> tuple[FloatArray, FloatArray]:
     """Unit tangents (in the direction of increasing φ) where the pieces start and where they end."""
+    starts, ends = pieces.tangents()
     last = len(pieces) - 1
     null = bool(pieces.line[last, 1] and np.all(pieces.start[last, 1] == pieces.end[last, 1]))
-    k_end = 0 if null else 1
-    out = []
-    for i, k, at in ((0, 0, pieces.start[0, 0]), (last, k_end, pieces.end[last, k_end])):
-        if pieces.line[i, k]:
-            d = pieces.end[i, k] - pieces.start[i, k]
-        else:
-            r = at - pieces.center[i, k]
-            d = np.array([-r[1], r[0]]) * (1.0 if pieces.ccw[i, k] else -1.0)
-        out.append(d / np.linalg.norm(d))
-    return out[0], out[1]
+    return starts[0, 0], ends[last, 0 if null else 1]

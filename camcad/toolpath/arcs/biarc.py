@@ -33,10 +33,12 @@ __all__ = [
     "arc_from_tangent",
     "biarc_pieces",
     "chord_pieces",
+    "circle_gap",
     "concat_pieces",
     "cross",
     "curve_nodes",
     "distance_to_pieces",
+    "left_normal",
     "measure_deviation",
     "norm2",
     "offset_pieces",
@@ -105,6 +107,22 @@ class Pieces:
         radius = 0.5 * (self.r_start + self.r_end)
         return np.where(self.line, chord, np.abs(self.sweep()) * radius)
 
+    def curvature(self) -> FloatArray:
+        """(n, 2) signed curvature of each piece [1/mm], + counter-clockwise; 0 for lines."""
+        with np.errstate(divide="ignore"):
+            return np.where(self.line, 0.0, np.where(self.ccw, 1.0, -1.0) / self.r_start)
+
+    def tangents(self) -> tuple[FloatArray, FloatArray]:
+        """(n, 2, 2) unit tangents of each piece at its start and at its end, along it (NaN if null)."""
+        chord = self.end - self.start
+        side = np.where(self.ccw, 1.0, -1.0)[..., None]
+        out = []
+        for at in (self.start, self.end):
+            d = np.where(self.line[..., None], chord, side * left_normal(at - self.center))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                out.append(d / norm2(d)[..., None])
+        return out[0], out[1]
+
 
 def angle_of(v: FloatArray) -> FloatArray:
     """Direction angle [rad] of 2-D vectors (..., 2), in (−π, π]."""
@@ -114,6 +132,22 @@ def angle_of(v: FloatArray) -> FloatArray:
 def cross(a: FloatArray, b: FloatArray) -> FloatArray:
     """z-component of the cross product of 2-D vectors (..., 2)."""
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def left_normal(v: FloatArray) -> FloatArray:
+    """2-D vectors (..., 2) turned by +90° (the left normal of a tangent)."""
+    return np.stack((-v[..., 1], v[..., 0]), axis=-1)
+
+
+def circle_gap(kappa: FloatArray, b: FloatArray, ww: FloatArray) -> FloatArray:
+    """Signed distance [mm] of points from the circle of curvature κ through p along t (w·n = b, |w|² = ww).
+
+    w = point − p and n the left normal of t; the form (κ|w|² − 2b)/(1 + √(1 − 2κb + κ²|w|²)) holds
+    for every κ, a straight line (κ = 0) included, without cancellation.
+    """
+    root = np.sqrt(np.maximum(1.0 - 2.0 * (kappa * b) + kappa * kappa * ww, 0.0))
+    out: FloatArray = (kappa * ww - 2.0 * b) / (1.0 + root)
+    return out
 
 
 def norm2(v: FloatArray) -> FloatArray:

@@ -31,8 +31,8 @@ the curve, and keeps the first whose two-way deviation, measured by
 :func:`~camcad.toolpath.arcs.biarc.measure_deviation`, is within the
 tolerance; it stops after ``_TRIES`` failed refits in a row. It runs only
 when asked (``[gcode] fewest_arcs``): on the shipped samples it drops 1–2
-arcs on eight of twelve (every loop then within 1.2 times the asymptotic
-fewest arcs of ``benchmarks/gcode.py``) for 0.2–0.5 s more per contour.
+arcs on seven of twelve (every loop then within 1.2 times the asymptotic
+fewest arcs of ``benchmarks/gcode.py``) for 0.1–0.4 s more per contour.
 """
 
 from __future__ import annotations
@@ -43,7 +43,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from camcad._typing import FloatArray
-from camcad.toolpath.arcs.biarc import CurveFn, Pieces, abeam, angle_of, cross, measure_deviation, single_arcs
+from camcad.toolpath.arcs.biarc import (
+    CurveFn,
+    Pieces,
+    abeam,
+    angle_of,
+    biarc_pieces,
+    circle_gap,
+    cross,
+    left_normal,
+    measure_deviation,
+    single_arcs,
+)
 
 __all__ = ["thin_loop"]
 
@@ -58,11 +69,6 @@ _WINDOW = 6  # samples either side of a joint's last nearest sample searched for
 _RATIOS = np.array([0.5, 0.7, 1.0, 1.4, 2.0])  # d₁/d of the biarcs tried in place of three arcs
 _TRIES = 4  # failed drops in a row before thinning stops
 _LARGEST_LOOP = 96  # arcs: a longer loop is left as the search made it (dense Jacobian, O(n²) per step)
-
-
-def _rot(v: FloatArray) -> FloatArray:
-    """The vectors turned by +90°."""
-    return np.stack((-v[..., 1], v[..., 0]), axis=-1)
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,7 +96,7 @@ def _joints(x: FloatArray, n: int) -> _Loop:
     chord = (s * sinc)[:, None] * u
     p = x[:2] + np.concatenate((np.zeros((1, 2)), np.cumsum(chord, axis=0)))
     # d(chord)/dκ = (s²/2)·(sinc'(h) u + sinc(h) u⊥), h = κs/2
-    dchord = (0.5 * s * s)[:, None] * (dsinc[:, None] * u + sinc[:, None] * _rot(u))
+    dchord = (0.5 * s * s)[:, None] * (dsinc[:, None] * u + sinc[:, None] * left_normal(u))
     return _Loop(x, n, p, th, dchord)
 
 
@@ -126,7 +132,7 @@ def _gaps(
     k, s = x[3 : 3 + n], x[3 + n :]
     pi, ti, ki = p[seg], th[seg], k[seg]
     t = np.stack((np.cos(ti), np.sin(ti)), axis=1)
-    nl = _rot(t)
+    nl = left_normal(t)
     w = q - pi
     b = np.sum(w * nl, axis=1)
     ww = np.sum(w * w, axis=1)
@@ -162,10 +168,10 @@ def _closure(loop: _Loop, turn: float, c0: FloatArray, t0: FloatArray) -> tuple[
     x, n, p, th, dchord = loop.x, loop.n, loop.p, loop.th, loop.dchord
     k, s = x[3 : 3 + n], x[3 + n :]
     c = np.array([p[n, 0] - p[0, 0], p[n, 1] - p[0, 1], th[n] - th[0] - turn, float((p[0] - c0) @ t0)])
-    rel = _rot(p[n] - p[1:])  # J(pₙ − pⱼ₊₁)
+    rel = left_normal(p[n] - p[1:])  # J(pₙ − pⱼ₊₁)
     t_end = np.stack((np.cos(th[1:]), np.sin(th[1:])), axis=1)
     jac = np.zeros((4, 3 + 2 * n))
-    jac[0:2, 2] = _rot(p[n] - p[0])
+    jac[0:2, 2] = left_normal(p[n] - p[0])
     jac[0:2, 3 : 3 + n] = (dchord + s[:, None] * rel).T
     jac[0:2, 3 + n :] = (t_end + k[:, None] * rel).T
     jac[2, 3 : 3 + n], jac[2, 3 + n :] = s, k
@@ -260,21 +266,11 @@ def _minimax(
 
 def _chain(pieces: Pieces) -> tuple[FloatArray, int]:
     """The chain x = (p₀, θ₀, κ…, s…) of the non-empty pieces in order (arcs and lines), and its length."""
-    sweep = pieces.sweep()
-    moves = np.any(pieces.start != pieces.end, axis=-1)
-    keep = np.flatnonzero(((sweep != 0.0) | (pieces.line & moves)).ravel())
-    start = pieces.start.reshape(-1, 2)[keep]
-    end = pieces.end.reshape(-1, 2)[keep]
-    center = pieces.center.reshape(-1, 2)[keep]
-    line = pieces.line.ravel()[keep]
-    ccw = pieces.ccw.ravel()[keep]
-    radius = pieces.r_start.ravel()[keep]
-    side = np.where(ccw, 1.0, -1.0)
-    k = np.where(line, 0.0, side / np.where(line, 1.0, radius))
-    s = np.where(line, np.linalg.norm(end - start, axis=1), np.abs(sweep.ravel()[keep]) * radius)
-    radial = start - center
-    t0 = end[0] - start[0] if line[0] else side[0] * _rot(radial[0])
-    return np.concatenate((start[0], [float(angle_of(t0[None])[0])], k, s)), int(keep.size)
+    length = pieces.length().ravel()
+    keep = np.flatnonzero(length > 0.0)
+    start_tangent = pieces.tangents()[0].reshape(-1, 2)[keep[0]]
+    head = np.concatenate((pieces.start.reshape(-1, 2)[keep[0]], angle_of(start_tangent[None])))
+    return np.concatenate((head, pieces.curvature().ravel()[keep], length[keep])), int(keep.size)
 
 
 def _pieces(curve: CurveFn, x: FloatArray, n: int, a: float, q: FloatArray, phi_q: FloatArray) -> Pieces:
@@ -305,11 +301,6 @@ def _drop(x: FloatArray, n: int, i: int) -> FloatArray:
     return np.concatenate((x[:3], np.delete(k, i), np.delete(s, i)))
 
 
-def _signed_turn(a: FloatArray, b: FloatArray) -> FloatArray:
-    """Signed angle [rad] from unit vectors a to b, in (−π, π]."""
-    return np.arctan2(cross(a, b), np.sum(a * b, axis=-1))
-
-
 def _merges(
     x: FloatArray, n: int, q: FloatArray, seg: np.ndarray
 ) -> tuple[np.ndarray, FloatArray, FloatArray]:
@@ -317,7 +308,7 @@ def _merges(
 
     The biarc runs between the joints around the three arcs with their
     tangents (so the rest of the loop is unchanged and it stays closed), its
-    d₁/d each of ``_RATIOS`` (Bolton's equal-chord biarc at 1). Returns the
+    d₁/d each of ``_RATIOS`` (:func:`~camcad.toolpath.arcs.biarc.biarc_pieces`). Returns the
     arc index of each guess (k,), the guesses (k, 3 + 2(n − 1)) and each
     guess's largest gap [mm] on the samples ``seg`` puts on the three arcs.
     """
@@ -325,29 +316,15 @@ def _merges(
     p, th = loop.p, loop.th
     k, s = x[3 : 3 + n], x[3 + n :]
     i = np.repeat(np.arange(1, n - 1), _RATIOS.size)
-    ratio = np.tile(_RATIOS, n - 2)
     p0, p1 = p[i - 1], p[i + 2]
     t0 = np.stack((np.cos(th[i - 1]), np.sin(th[i - 1])), axis=1)
     t1 = np.stack((np.cos(th[i + 2]), np.sin(th[i + 2])), axis=1)
-    v = p1 - p0
-    vt, vv, c = np.sum(v * (t0 + t1), axis=1), np.sum(v * v, axis=1), 1.0 - np.sum(t0 * t1, axis=1)
-    d = vv / (vt + np.sqrt(np.maximum(vt * vt + 2.0 * c * vv, 0.0)))  # Bolton 1975, as in biarc_pieces
-    d1 = d * ratio
-    d2 = (vv - 2.0 * d1 * np.sum(v * t0, axis=1)) / (2.0 * (np.sum(v * t1, axis=1) + d1 * c))
-    q0, q1 = p0 + d1[:, None] * t0, p1 - d2[:, None] * t1
-    joint = q0 + (d1 / (d1 + d2))[:, None] * (q1 - q0)
-    tm = (q1 - q0) / np.linalg.norm(q1 - q0, axis=1)[:, None]
-
-    def arc(a: FloatArray, ta: FloatArray, b: FloatArray, tb: FloatArray) -> tuple[FloatArray, FloatArray]:
-        turn = _signed_turn(ta, tb)
-        chord = np.linalg.norm(b - a, axis=1)
-        half = 0.5 * turn
-        length = chord * np.where(np.abs(half) < 1e-8, 1.0, half / np.where(half == 0.0, 1.0, np.sin(half)))
-        return turn / length, length
-
-    ka, sa = arc(p0, t0, joint, tm)
-    kb, sb = arc(joint, tm, p1, t1)
-    ok = (d1 > 0.0) & (d2 > 0.0) & np.isfinite(ka + kb + sa + sb)
+    zero = np.zeros(i.size)
+    biarc = biarc_pieces(zero, zero, p0, t0, p1, t1, ratio=np.tile(_RATIOS, n - 2))
+    curvature, length = biarc.curvature(), biarc.length()
+    ka, kb, sa, sb = curvature[:, 0], curvature[:, 1], length[:, 0], length[:, 1]
+    joint, tm = biarc.end[:, 0], biarc.tangents()[0][:, 1]
+    ok = np.isfinite(ka + kb + sa + sb) & np.all(np.isfinite(tm), axis=1)
     out = np.empty((i.size, 3 + 2 * (n - 1)))
     out[:, :3] = x[:3]
     for row in np.flatnonzero(ok):
@@ -370,8 +347,7 @@ def _merges(
     v = w - start
     b = cross(tang, v)
     vv = np.sum(v * v, axis=2)
-    gap = (kap * vv - 2.0 * b) / (1.0 + np.sqrt(np.maximum(1.0 - 2.0 * kap * b + kap * kap * vv, 0.0)))
-    worst = np.where(inside, np.abs(gap), 0.0).max(axis=1)
+    worst = np.where(inside, np.abs(circle_gap(kap, b, vv)), 0.0).max(axis=1)
     return i[ok], out[ok], worst[ok]
 
 

@@ -29,8 +29,10 @@ from camcad.toolpath.arcs.biarc import (
     abeam,
     angle_of,
     biarc_pieces,
+    circle_gap,
     cross,
     distance_to_pieces,
+    left_normal,
     measure_deviation,
     norm2,
     single_arcs,
@@ -56,10 +58,6 @@ _CIRCLE_RUN = 4  # samples: a stretch of constant curvature at least this long i
 _CIRCLE_SAME = 1e-6  # mm: samples whose centres and radii of curvature agree this closely share a circle
 _CIRCLE_LARGEST = 1e6  # mm: a larger radius is a straight line, not a circle
 _CIRCLE_STATES = 8  # states kept per layer on circles ahead
-
-
-def _left(t: FloatArray) -> FloatArray:
-    return np.stack((-t[..., 1], t[..., 0]), axis=-1)
 
 
 @dataclass(frozen=True, slots=True)
@@ -115,7 +113,7 @@ def _screen(
     kappa = kappa.reshape(j.size, -1)
     w = pts[idx] - p[:, None, :]
     abw = np.stack(
-        (np.einsum("swi,si->sw", w, t), np.einsum("swi,si->sw", w, _left(t)), np.sum(w * w, axis=-1))
+        (np.einsum("swi,si->sw", w, t), np.einsum("swi,si->sw", w, left_normal(t)), np.sum(w * w, axis=-1))
     )  # (3, s, width): a = w·t, b = w·n, |w|²
     lo, hi = _admissible(*abw, band)
     first = _first_out(np.maximum.accumulate(lo, axis=1), np.minimum.accumulate(hi, axis=1), kappa)
@@ -128,7 +126,7 @@ def _admissible(a: FloatArray, b: FloatArray, ww: FloatArray, band: float) -> tu
     """The curvatures [lo, hi] (1/mm) of the arcs from a state that pass within ``band`` of each sample.
 
     The arc of curvature κ through the state's point along its tangent has
-    the signed distance :func:`_gap` from a sample at w (w·t = a, w·n = b),
+    the signed distance :func:`~camcad.toolpath.arcs.biarc.circle_gap` from a sample at w (w·t = a, w·n = b),
     which grows with κ; it equals δ at κ = 2(b + δ)/(|w|² − δ²), so the band
     |gap| ≤ band is κ between the values at δ = ∓band (a sample within the
     band of the point itself bounds nothing). A sample behind the start
@@ -188,12 +186,7 @@ def _ends(kappa: FloatArray, reach: np.ndarray, abw: FloatArray, rows: np.ndarra
     kk = np.repeat(kappa.reshape(-1), count)
     flat = s_i * width + w_i
     a, b, ww = (np.take(abw[k].reshape(-1), flat) for k in range(3))
-    return s_i, w_i, kk, _gap(kk, b, ww), a, b, last
-
-
-def _gap(k: FloatArray, b: FloatArray, ww: FloatArray) -> FloatArray:
-    """Signed distance [mm] of samples (w·n = b, |w|² = ww) from the arc of curvature k."""
-    return (k * ww - 2.0 * b) / (1.0 + np.sqrt(np.maximum(1.0 - 2.0 * (k * b) + k * k * ww, 0.0)))
+    return s_i, w_i, kk, circle_gap(kk, b, ww), a, b, last
 
 
 def _expand(
@@ -243,13 +236,13 @@ def _expand(
 def _arc_to(p: FloatArray, t: FloatArray, kappa: FloatArray, q: FloatArray) -> FloatArray:
     """The point of the arc (p, t, κ) abeam q (n, 2): where the ray from the centre to q meets it."""
     w = q - p
-    a, b = np.sum(w * t, axis=-1), np.sum(w * _left(t), axis=-1)
+    a, b = np.sum(w * t, axis=-1), np.sum(w * left_normal(t), axis=-1)
     small = np.abs(kappa) < 1e-12
     k = np.where(small, 1.0, kappa)
     turn = np.where(small, 0.0, np.arctan2(kappa * a, 1.0 - kappa * b))
     along = np.where(small, a, np.sin(turn) / k)
     side = np.where(small, 0.0, (1.0 - np.cos(turn)) / k)
-    return p + along[:, None] * t + side[:, None] * _left(t)
+    return p + along[:, None] * t + side[:, None] * left_normal(t)
 
 
 def _close(
@@ -310,9 +303,9 @@ def _near_samples(
     """
     idx = np.rint(j0[:, None] + (j1 - j0)[:, None] * np.linspace(0.0, 1.0, 9)[1:-1]).astype(int)
     w = pts[np.clip(idx, 0, pts.shape[0] - 1)] - p[:, None, :]
-    b = np.einsum("swi,si->sw", w, _left(t))
+    b = np.einsum("swi,si->sw", w, left_normal(t))
     with np.errstate(invalid="ignore"):
-        out: np.ndarray = np.all(np.abs(_gap(kappa[:, None], b, np.sum(w * w, axis=-1))) <= tol, axis=1)
+        out: np.ndarray = np.all(np.abs(circle_gap(kappa[:, None], b, np.sum(w * w, axis=-1))) <= tol, axis=1)
     return out
 
 
@@ -328,7 +321,7 @@ def _touching(
     tangent there (NaN where there is none).
     """
     w = p - c1
-    nl = _left(t)
+    nl = left_normal(t)
     with np.errstate(divide="ignore", invalid="ignore"):
         kappa = 2.0 * (np.sum(nl * w, axis=1) + rho1) / (rho1 * rho1 - np.sum(w * w, axis=1))
         m = (kappa[:, None] * w + nl) / (1.0 - kappa * rho1)[:, None]
@@ -361,7 +354,7 @@ def _circles(pts: FloatArray, d1: FloatArray, d2: FloatArray) -> _Circles:
     kappa = cross(d1, d2) / speed**3
     with np.errstate(divide="ignore"):
         rho = 1.0 / kappa
-    center = pts + rho[:, None] * _left(d1 / speed[:, None])
+    center = pts + rho[:, None] * left_normal(d1 / speed[:, None])
     same = (np.abs(np.diff(rho)) <= _CIRCLE_SAME) & (norm2(np.diff(center, axis=0)) <= _CIRCLE_SAME)
     same &= np.isfinite(rho[1:]) & (np.abs(rho[1:]) < _CIRCLE_LARGEST)
     edges = np.flatnonzero(np.diff(np.concatenate(([0], same.astype(int), [0]))))
@@ -530,7 +523,7 @@ def search_arcs(
     tan = d1 / norm2(d1)[:, None]
     circles = _circles(pts, d1, d2)
     tan_ang = angle_of(tan)
-    nrm = _left(tan)
+    nrm = left_normal(tan)
     zero = np.zeros(1, int)
     layers = [_Layer(zero, pts[:1], tan[:1], zero, None, np.zeros(1), phi[:1])]
     width = 64
@@ -562,7 +555,7 @@ def search_arcs(
         turn = 2.0 * np.arctan2(
             cross(layer.t[s], q[keep] - layer.p[s]), np.sum((q[keep] - layer.p[s]) * layer.t[s], axis=-1)
         )
-        t2 = np.cos(turn)[:, None] * layer.t[s] + np.sin(turn)[:, None] * _left(layer.t[s])
+        t2 = np.cos(turn)[:, None] * layer.t[s] + np.sin(turn)[:, None] * left_normal(layer.t[s])
         new = _Layer(end, q[keep], t2, s, pc, dev, phi[end])
         extra = _onto_circles(curve, layer, circles, phi, pts, tolerance, width) if circles.rho.size else None
         layers.append(new if extra is None else _join(new, extra))
