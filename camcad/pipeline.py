@@ -198,20 +198,26 @@ def analyse(
 
         groove = positive.groove is not None  # a groove cam: slot and flank passes (camcad.toolpath.groove)
         planned = _limited(
-            lambda: plan_groove(
-                cam,
-                design.gcode,
-                name=design.cam.name,
-                thickness=design.cam.thickness,
-                depth=design.groove.depth,
-                clearance=design.groove.clearance,
-                bore=design.cam.bore,
-            )
-            if groove
-            else plan_rotary(cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness)
-            if rotary
-            else plan_toolpath(
-                cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
+            lambda: (
+                plan_groove(
+                    cam,
+                    design.gcode,
+                    name=design.cam.name,
+                    thickness=design.cam.thickness,
+                    depth=design.groove.depth,
+                    clearance=design.groove.clearance,
+                    bore=design.cam.bore,
+                )
+                if groove
+                else plan_rotary(cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness)
+                if rotary
+                else plan_toolpath(
+                    cam,
+                    design.gcode,
+                    name=design.cam.name,
+                    thickness=design.cam.thickness,
+                    bore=design.cam.bore,
+                )
             ),
             timings=timings,
             progress=progress,
@@ -221,14 +227,17 @@ def analyse(
         )
     if planned is not None and positive.second_plate:
         first = timings["toolpath"]
-        positive = _limited(
-            lambda: plan_partner(positive, design),
-            timings=timings,
-            progress=progress,
-            stage="toolpath",
-            strict=strict,
-            found=later,
-        ) or positive
+        positive = (
+            _limited(
+                lambda: plan_partner(positive, design),
+                timings=timings,
+                progress=progress,
+                stage="toolpath",
+                strict=strict,
+                found=later,
+            )
+            or positive
+        )
         timings["toolpath"] += first  # both plates' plans
     fea_result = None
     if fea and not hard:

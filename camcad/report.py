@@ -639,8 +639,9 @@ def compare_text(analyses: Sequence[Analysis], *, width: int = 100) -> str:
     def render(rows: list[list[str]]) -> list[str]:
         widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
         return [
-            "  ".join(c.rjust(w) if j else c.ljust(w) for j, (c, w) in enumerate(zip(r, widths, strict=True)))
-            .rstrip()
+            "  ".join(
+                c.rjust(w) if j else c.ljust(w) for j, (c, w) in enumerate(zip(r, widths, strict=True))
+            ).rstrip()
             for r in rows
         ]
 

@@ -1,6 +1,6 @@
 """The project's static gates run in the suite, so they run wherever the suite does (CI too).
 
-ruff keeps the whole tree clean, and mypy keeps the typed core strict: motion,
+ruff keeps the whole tree clean and formatted, and mypy keeps the typed core strict: motion,
 geometry and fit and the bottom modules they share (rules and settings in
 pyproject.toml). Both run through ``sys.executable -m``, so they are the ones
 installed with the test extra, and a missing tool fails instead of skipping.
@@ -42,6 +42,11 @@ def _run(tool: str, *args: str) -> subprocess.CompletedProcess[str]:
 
 def test_ruff_is_clean():
     proc = _run("ruff", "check", ".")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_ruff_format_leaves_every_file_as_it_is():
+    proc = _run("ruff", "format", "--check", ".")
     assert proc.returncode == 0, proc.stdout + proc.stderr
 
 

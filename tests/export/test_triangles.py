@@ -255,4 +255,3 @@ def test_write_meshes_writes_the_encodings(keyed, tmp_path):
     assert paths[0].read_bytes() == stl_bytes(keyed.mesh)
     assert paths[1].read_bytes() == threemf_bytes(keyed.mesh, name="cam_2")
     assert paths[2].read_bytes() == ply_bytes(keyed.mesh)
-

@@ -247,8 +247,14 @@ def _crossover_roots(cam: Cam, force_of_motion: Any) -> list[float]:
     for i, n in itertools.pairwise(live):
         if np.sign(f[i]) != np.sign(f[n]):
             if n == i + 1:
-                roots.append(brentq(lambda p: float(force_of_motion(cam.motion(np.array([p])))[0]),
-                                    grid[i], grid[n], xtol=1e-13))
+                roots.append(
+                    brentq(
+                        lambda p: float(force_of_motion(cam.motion(np.array([p])))[0]),
+                        grid[i],
+                        grid[n],
+                        xtol=1e-13,
+                    )
+                )
             else:
                 roots.append(float(grid[n - 1]))  # a rest ends at a joint on the grid (whole degrees)
     return sorted(r % (2.0 * math.pi) for r in roots)
