@@ -32,7 +32,7 @@ the curve, and keeps the first whose two-way deviation, measured by
 tolerance; it stops after ``_TRIES`` failed refits in a row. It runs only
 when asked (``[gcode] fewest_arcs``): on the shipped samples it drops 1–2
 arcs on seven of twelve (every loop then within 1.2 times the asymptotic
-fewest arcs of ``benchmarks/gcode.py``) for 0.1–0.4 s more per contour.
+fewest arcs of ``benchmarks/gcode.py``) for up to 0.27 s more per contour.
 """
 
 from __future__ import annotations
