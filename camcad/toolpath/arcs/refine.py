@@ -85,7 +85,7 @@ class _Loop:
 
 
 def _joints(x: FloatArray, n: int) -> _Loop:
-    """The chain's joints, tangent angles and each arc's chord vector's derivative by κ."""
+    """The chain's joints, their tangent angles and unit tangents, and dchord/dκ of each arc."""
     k, s = x[3 : 3 + n], x[3 + n :]
     half = 0.5 * k * s
     th = np.empty(n + 1)
@@ -110,7 +110,7 @@ def _joints(x: FloatArray, n: int) -> _Loop:
     # d(chord)/dκ = (s²/2)·(sinc'(h) u + sinc(h) u⊥), h = κs/2
     scale = 0.5 * s * s
     dchord = np.empty((n, 2))
-    dchord[:, 0] = scale * (dsinc * u0 + sinc * -u1)
+    dchord[:, 0] = scale * (dsinc * u0 - sinc * u1)
     dchord[:, 1] = scale * (dsinc * u1 + sinc * u0)
     return _Loop(x, n, p, th, tan, dchord)
 
