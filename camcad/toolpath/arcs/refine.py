@@ -150,6 +150,7 @@ def _gaps(
     w0, w1 = w[:, 0], w[:, 1]
     b = cross(t, w)  # w·n, n the left normal
     ww = w0 * w0 + w1 * w1
+    # circle_gap's form written out: the Jacobian below needs its f, root and den (root kept off 0)
     f = ki * ww - 2.0 * b
     root = np.sqrt(np.maximum(1.0 - 2.0 * ki * b + ki * ki * ww, 1e-300))
     den = 1.0 + root
