@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+from dataclasses import replace
 from functools import cache
 from pathlib import Path
 
@@ -41,13 +42,17 @@ CONFIGS = {
         "tool_number": 7,
     },
     "start-200-fine": {"start_angle": 200.0, "tolerance": 0.001, "tool_diameter": 4.0, "step_down": 3.0},
+    "fewest-arcs-tabs": {"fewest_arcs": True, "tab_count": 3},
 }
+LAWS = {"fewest-arcs-tabs": "cycloidal"}  # a cam whose finishing loop the refit thins (22 → 20 arcs)
 DIALECTS = ("linuxcnc", "grbl", "generic")
 
 
 @cache
 def planned(config: str) -> tuple[Design, Cam, Toolpath]:
-    design = make_design(law="poly-345", offset=4.0, extra={"cam": {"bore": 12.0}, "gcode": CONFIGS[config]})
+    design = make_design(
+        law=LAWS.get(config, "poly-345"), offset=4.0, extra={"cam": {"bore": 12.0}, "gcode": CONFIGS[config]}
+    )
     cam = Cam.from_design(design)
     tp = plan_toolpath(
         cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
@@ -99,6 +104,16 @@ def test_rs274_accepts_program_and_its_motion_passes_the_proof(config, dialect, 
     assert sum(1 for line in canon.splitlines() if "ARC_FEED(" in line) == sum(
         1 for m in ours if m.kind.is_arc
     )
+
+
+def test_the_fewest_arcs_program_it_runs_is_a_thinned_loop():
+    """The fewest-arcs configuration above exercises the refit: fewer arcs than the search's loop."""
+    design, cam, tp = planned("fewest-arcs-tabs")
+    plain = replace(design.gcode, fewest_arcs=False)
+    searched = plan_toolpath(
+        cam, plain, name=design.cam.name, thickness=design.cam.thickness, bore=design.cam.bore
+    )
+    assert tp.contour_arcs < searched.contour_arcs
 
 
 def test_rs274_catches_an_arc_whose_radii_disagree(tmp_path):
