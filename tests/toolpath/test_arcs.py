@@ -437,6 +437,93 @@ def test_the_screen_reach_is_the_first_sample_a_walk_finds_outside_the_band(seed
             assert near_tie[min(walk, first)]
 
 
+@settings(max_examples=100, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    radius=st.floats(-500.0, 500.0).filter(lambda r: abs(r) > 2.0),
+    straight=st.booleans(),
+)
+def test_the_gap_between_samples_is_the_distance_to_the_arc_s_circle(seed, radius, straight):
+    """_between_samples against each point's distance from the circle's centre, |‖q − c‖ − R| or |w·n|."""
+    from camcad.toolpath.arcs.search import _between_samples
+
+    rng = np.random.default_rng(seed)
+    mids = rng.uniform(-20.0, 20.0, (200, 2))
+    arcs = 12
+    p = rng.uniform(-20.0, 20.0, (arcs, 2))
+    t = unit(rng.uniform(-math.pi, math.pi, arcs))
+    kappa = np.zeros(arcs) if straight else 1.0 / radius * rng.uniform(0.5, 1.5, arcs)
+    j0 = rng.integers(0, 150, arcs)
+    j1 = j0 + rng.integers(1, 50, arcs)
+    got = _between_samples(p, t, kappa, mids, j0, j1)
+    for i in range(arcs):
+        w = mids[j0[i] : j1[i]] - p[i]
+        if kappa[i] == 0.0:
+            dist = np.abs(w[:, 0] * -t[i, 1] + w[:, 1] * t[i, 0])
+        else:
+            centre = p[i] + np.array([-t[i, 1], t[i, 0]]) / kappa[i]
+            dist = np.abs(np.linalg.norm(mids[j0[i] : j1[i]] - centre, axis=1) - 1.0 / abs(kappa[i]))
+        assert got[i] == pytest.approx(dist.max(), rel=1e-9, abs=1e-9)
+
+
+CURVES = {"ellipse": ellipse(60.0, 35.0), "wobble": wobble(), "concave": wobble(40.0, 3.0, 5)}
+
+
+@pytest.mark.parametrize("closed", [False, True], ids=["open", "closed"])
+@pytest.mark.parametrize("tol", [0.004, 0.001], ids=lambda t: f"tol{t:g}")
+@pytest.mark.parametrize("name", sorted(CURVES))
+def test_arcs_kept_unmeasured_give_the_search_of_every_arc_measured(name, tol, closed):
+    """The search keeps arcs midway in the band unmeasured: the same arcs, bit for bit, as measuring all."""
+    from dataclasses import fields
+
+    from camcad.toolpath.arcs.search import _search
+
+    b = 2.0 * math.pi if closed else 2.5
+    lazy, devs = search_arcs(CURVES[name], 0.0, b, tol, closed=closed)
+    every = _search(CURVES[name], 0.0, b, tol, closed, -math.inf)
+    assert every is not None
+    assert len(lazy) == len(every[0])
+    for got, want in zip(lazy, every[0], strict=True):
+        for f in fields(got):
+            np.testing.assert_array_equal(getattr(got, f.name), getattr(want, f.name))
+    for got, want in zip(devs, every[1], strict=True):
+        np.testing.assert_array_equal(got, want)
+    assert max(float(d.max()) for d in devs) <= tol
+
+
+def test_an_unmeasured_arc_that_fails_on_the_path_makes_the_search_measure_every_arc(monkeypatch):
+    """When the path's unmeasured arcs fail their measurement, the search runs again measuring every arc."""
+    from camcad.toolpath.arcs import search
+
+    curve, tol = wobble(), 0.004
+    want = search._search(curve, 0.0, 2.5, tol, False, -math.inf)
+    assert want is not None
+    monkeypatch.setattr(search, "_SURE", math.inf)  # no layer measures: the path's arcs are, in _trace
+    real, runs, failed = search.measure_deviation, [], []
+
+    def failing_once(curve, pieces, **kw):
+        out = real(curve, pieces, **kw)
+        if kw.get("samples") == search._LAYER_SAMPLES and not failed:
+            failed.append(len(pieces))
+            return out + 2.0 * tol
+        return out
+
+    def counted(*args):
+        runs.append(args[-1])
+        return real_search(*args)
+
+    real_search = search._search
+    monkeypatch.setattr(search, "measure_deviation", failing_once)
+    monkeypatch.setattr(search, "_search", counted)
+    got, devs = search.search_arcs(curve, 0.0, 2.5, tol)
+    assert runs == [math.inf, -math.inf] and failed
+    assert len(got) == len(want[0])
+    for a, b in zip(got, want[0], strict=True):
+        np.testing.assert_array_equal(a.center, b.center)
+    for a, b in zip(devs, want[1], strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
 def test_the_refit_s_jacobians_are_its_finite_differences():
     """refine: dg/dx of every sample's gap and of the four loop equations equal central differences."""
     from camcad.toolpath.arcs import refine

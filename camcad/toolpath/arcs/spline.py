@@ -82,8 +82,9 @@ def fit_arc_spline(
     each leaving along the previous arc's end tangent and ending anywhere
     within the band. A breadth-first search keeps, after k arcs, the end
     state farthest along the curve in each cell of (normal offset, tangent
-    error); arcs are screened on curve samples (0.97 tol) and each kept arc
-    is measured; states exactly on the circles of stretches of constant
+    error); arcs are screened on curve samples (0.97 tol) and checked between
+    them, measured where that leaves doubt, and every arc of the path is
+    measured; states exactly on the circles of stretches of constant
     curvature (dwells) are added. The interval closes with a measured biarc
     onto the break node, which stays on the curve with the curve's tangent,
     from the first layer where one fits, or, with ``closed``, with one arc
