@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
@@ -106,11 +106,17 @@ def test_report_bytes_equal_across_processes(tmp_path):
     span=st.floats(min_value=1e-6, max_value=1e7),
     most=st.integers(min_value=3, max_value=10),
 )
+@example(lo=879609.9999999999, span=1e-06, most=6)  # the last tick lies one ulp of 8.8e5 beyond hi
 def test_nice_ticks_cover_the_range_evenly(lo, span, most):
-    """Ticks lie in [lo, hi], at most about `most`, evenly spaced by 1, 2, 2.5 or 5 × 10^k, labels exact."""
+    """Ticks lie in [lo, hi], at most about `most`, evenly spaced by 1, 2, 2.5 or 5 × 10^k, labels exact.
+
+    [lo, hi] to float resolution: a few ulps of the range's magnitude besides 1e-9 of its span, since
+    hi = lo + span and every tick k × step are rounded there (a span of 1e-6 at 8.8e5 is 8600 ulps).
+    """
     hi = lo + span
     ticks, decimals = nice_ticks(lo, hi, most)
-    assert ticks and all(lo - 1e-9 * span <= t <= hi + 1e-9 * span for t in ticks)
+    slack = 1e-9 * span + 4.0 * math.ulp(max(abs(lo), abs(hi)))
+    assert ticks and all(lo - slack <= t <= hi + slack for t in ticks)
     assert len(ticks) <= most + 2
     if len(ticks) > 1:
         step = round((ticks[-1] - ticks[0]) / (len(ticks) - 1), decimals + 2)  # float cancellation far from 0
