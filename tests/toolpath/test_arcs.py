@@ -524,6 +524,38 @@ def test_an_unmeasured_arc_that_fails_on_the_path_makes_the_search_measure_every
         np.testing.assert_array_equal(a, b)
 
 
+@pytest.mark.parametrize("sure", [math.inf, -math.inf], ids=["path", "layers"])
+def test_a_measurement_that_comes_back_nan_rejects_the_arc(monkeypatch, sure):
+    """An arc measured as NaN fails as one measured far off, in the layers and on the path.
+
+    (The layers mark an arc not yet measured with a NaN deviation.)
+    """
+    from camcad.toolpath.arcs import search
+
+    curve, tol, real = wobble(), 0.004, search.measure_deviation
+
+    def spoiled(value):
+        def measure(curve, pieces, **kw):
+            out = real(curve, pieces, **kw)
+            if kw.get("samples") == search._LAYER_SAMPLES:
+                out = np.where(out > 0.9 * tol, value, out)  # the same arcs spoiled either way
+            return out
+
+        return measure
+
+    runs = {}
+    for value in (np.nan, np.inf):
+        monkeypatch.setattr(search, "measure_deviation", spoiled(value))
+        runs[str(value)] = search._search(curve, 0.0, 2.5, tol, False, sure)
+    if sure == math.inf:  # nothing measured in the layers: the path's spoiled arcs fail it
+        assert runs["nan"] is None and runs["inf"] is None
+    else:
+        assert runs["nan"] is not None and runs["inf"] is not None
+        for a, b in zip(runs["nan"][0], runs["inf"][0], strict=True):
+            np.testing.assert_array_equal(a.center, b.center)
+        assert all(float(d.max()) <= 0.9 * tol for d in runs["nan"][1][:-1])
+
+
 def test_the_refit_s_jacobians_are_its_finite_differences():
     """refine: dg/dx of every sample's gap and of the four loop equations equal central differences."""
     from camcad.toolpath.arcs import refine

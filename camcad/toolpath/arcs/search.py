@@ -581,7 +581,8 @@ def _search(
                 gap = _between_samples(layer.p[s], layer.t[s], kappa, between, per * layer.j[s], per * end)
                 doubt = np.flatnonzero(~(gap <= sure * tolerance))
                 if doubt.size:
-                    dev[doubt] = measure_deviation(curve, take_pieces(pc, doubt), samples=_LAYER_SAMPLES)
+                    measured = measure_deviation(curve, take_pieces(pc, doubt), samples=_LAYER_SAMPLES)
+                    dev[doubt] = np.where(np.isnan(measured), np.inf, measured)  # NaN marks the unmeasured
             keep = ~(dev > tolerance)
             if keep.any():
                 break
@@ -664,7 +665,7 @@ def _trace(
         # concat_pieces sorts by φ: the measurements come in that order
         todo = todo[np.argsort([pieces[k].lo[0] for k in todo], kind="stable")]
         measured = measure_deviation(curve, concat_pieces([pieces[k] for k in todo]), samples=_LAYER_SAMPLES)
-        if np.any(measured > tol):
+        if not np.all(measured <= tol):
             return None
         for k, d in zip(todo, measured, strict=True):
             devs[k][0] = d
