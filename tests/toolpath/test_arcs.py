@@ -243,6 +243,10 @@ def test_a_closed_curve_closes_on_its_first_arc_one_arc_shorter(tol):
 )  # fmt: skip
 # κρ₁ = 1 − 7.5e-5: |t_x| is 1 + 2.3e-9
 @example(px=0.0, py=2.0, heading=0.0, cx=0.0, cy=0.0003, rho=2.0, ccw=False)
+# p 1.2e-7 inside the circle, along it (κρ₁ = 1 − 1.3e-8): the arc is the circle, so there is no X
+@example(
+    px=0.0, py=1.192092896e-07, heading=0.0, cx=0.0, cy=4.111226595503638, rho=4.111226595503638, ccw=True
+)
 def test_an_arc_touching_a_circle_lands_on_it_with_the_circle_s_tangent(px, py, heading, cx, cy, rho, ccw):
     """_touching: X lies on both circles, and both travel through X with the same unit tangent."""
     from camcad.toolpath.arcs.search import _touching

@@ -68,6 +68,7 @@ _CIRCLE_RUN = 4  # samples: a stretch of constant curvature at least this long i
 _CIRCLE_SAME = 1e-6  # mm: samples whose centres and radii of curvature agree this closely share a circle
 _CIRCLE_LARGEST = 1e6  # mm: a larger radius is a straight line, not a circle
 _CIRCLE_STATES = 8  # states kept per layer on circles ahead
+_SAME_CIRCLE = 1e-6  # |1 − κρ₁| below this, an arc that would touch a circle is the circle (_touching)
 
 
 @dataclass(frozen=True, slots=True)
@@ -328,12 +329,16 @@ def _touching(
     touches the circle where |w + n/κ| = |1/κ − ρ₁|, which is linear in κ:
     κ = 2(n·w + ρ₁)/(ρ₁² − |w|²); the circles touch at X = c₁ − ρ₁ m with the
     unit normal m = (κw + n)/(1 − κρ₁). Returns κ (1/mm), X and the unit
-    tangent there (NaN where there is none).
+    tangent there (NaN where there is none). Where |1 − κρ₁| < ``_SAME_CIRCLE``
+    the arc is the circle itself (the state lies on it, along it): X is then
+    any point of both, and the formula's is noise (off both circles by
+    millimetres at 1e-8), so there is none.
     """
     w = p - c1
     nl = left_normal(t)
     with np.errstate(divide="ignore", invalid="ignore"):
         kappa = 2.0 * (np.sum(nl * w, axis=1) + rho1) / (rho1 * rho1 - np.sum(w * w, axis=1))
+        kappa = np.where(np.abs(1.0 - kappa * rho1) < _SAME_CIRCLE, np.nan, kappa)
         m = (kappa[:, None] * w + nl) / (1.0 - kappa * rho1)[:, None]
     x = c1 - rho1[:, None] * m
     return kappa, x, np.stack((m[:, 1], -m[:, 0]), axis=1)
