@@ -34,6 +34,7 @@ __all__ = [
     "point_envelope",
     "pressure_angle",
     "to_cam",
+    "translation_envelope",
 ]
 
 
@@ -117,14 +118,46 @@ def point_envelope(phi: FloatArray, element: PointElement, sigma: float) -> tupl
     pitch = curve_sample(
         phi, to_cam(phi, m0, sigma), to_cam(phi, l1, sigma), to_cam(phi, l2, sigma), clockwise=sigma > 0
     )
+    return pitch, _rho_rate(l1, l2, l3, sigma)
+
+
+def _rho_rate(l1: FloatArray, l2: FloatArray, l3: FloatArray, sigma: float) -> FloatArray:
+    """dρ/dφ [mm/rad] of a curve with φ-derivatives L1, L2, L3 (n, 2), running clockwise for σ = +1.
+
+    dρ/dφ = s(3|L1|(L1·L2)(L1×L2) − |L1|³(L1×L3))/(L1×L2)² with s = −σ
+    (the derivative of ρ = s|L1|³/(L1×L2)); 0 where the curve is straight.
+    """
     speed = np.hypot(l1[:, 0], l1[:, 1])
     cross12 = l1[:, 0] * l2[:, 1] - l1[:, 1] * l2[:, 0]
     cross13 = l1[:, 0] * l3[:, 1] - l1[:, 1] * l3[:, 0]
     dot12 = np.einsum("ij,ij->i", l1, l2)
     with np.errstate(divide="ignore", invalid="ignore"):
         drho = -sigma * (3.0 * speed * dot12 * cross12 - speed**3 * cross13) / cross12**2
-    drho = np.where(cross12 == 0.0, 0.0, drho)
-    return pitch, drho
+    out: FloatArray = np.where(cross12 == 0.0, 0.0, drho)
+    return out
+
+
+def translation_envelope(
+    phi: FloatArray, element: PointElement, speed: float
+) -> tuple[CurveSample, FloatArray]:
+    """The path of a machine point M(φ) seen from a plate that moves by −speed·φ along x, and dρ/dφ.
+
+    The translating counterpart of :func:`point_envelope` (a linear cam, or a
+    barrel cam developed at one radius): in the plate's frame the point is
+    X(φ) = M(φ) + (cφ, 0) with c = ``speed`` [mm/rad] > 0, so X′ = M′ + (c, 0),
+    X″ = M″, X‴ = M‴. The curve runs towards +x, its outward normal is on its
+    left (towards the follower, +y), and its radius ρ is positive where it is
+    convex seen from there, as for a counter-clockwise disc cam, of which it
+    is the limit R → ∞ with Rφ held (Rothbart 2004, §6.3 with the rotation
+    replaced by a translation).
+    """
+    m0, m1, m2, m3 = element.m0, element.m1, element.m2, element.m3
+    shift = np.zeros_like(m0)
+    shift[:, 0] = speed
+    l1 = m1 + shift
+    point = m0 + np.column_stack((speed * np.asarray(phi, dtype=float), np.zeros_like(phi)))
+    pitch = curve_sample(phi, point, l1, m2, clockwise=True)
+    return pitch, _rho_rate(l1, m2, m3, 1.0)
 
 
 def line_envelope(phi: FloatArray, element: LineElement, sigma: float) -> tuple[CurveSample, FloatArray]:
