@@ -34,6 +34,7 @@ from camcad.geometry.barrel import (
     _contact,
     _pressure,
     check_barrel,
+    walls_at_radius,
 )
 from camcad.geometry.curves import CurveSample, curve_sample
 from camcad.geometry.envelope import PointElement, offset_curve, translation_envelope
@@ -107,7 +108,7 @@ class BarrelLimits:
     ``stretch_min``: the smallest λ of the (upper, lower) wall at the
     pitch station and at the bottom, ``{"pitch": (upper, lower), "bottom": (...)}``
     (≤ 0: the wall loops); ``z_range``: the lowest point of the lower wall
-    and the highest of the upper wall at the barrel's surface [mm];
+    and the highest of the upper wall, on the barrel's surface (radius R) [mm];
     ``findings``: a hard finding for a wall that loops.
     """
 
@@ -153,12 +154,12 @@ def barrel_limits(
         m = program.evaluate(phi, side=side)
         axis = follower.centre(m)
         up = _contact(axis, stations, options, WallSide.UPPER, clearance=True)
-        low = _contact(axis, stations, options, WallSide.LOWER, clearance=True)
         alpha = np.abs(_pressure(up, follower.driven(m), k))
         pitch_walls = developed_walls(m, follower, options, tp)
         bottom_walls = developed_walls(m, follower, options, bottom)
-        z_low = low.z[:, 2] + low.r[:, 2] * low.sin[:, 2]
-        z_high = up.z[:, 2] + up.r[:, 2] * up.sin[:, 2]
+        # the walls' edges on the barrel's surface (each wall reaches farthest from the pitch line there)
+        z_low = walls_at_radius(m, follower, options, top, WallSide.LOWER)[1].point[:, 0, 2]
+        z_high = walls_at_radius(m, follower, options, top, WallSide.UPPER)[1].point[:, 0, 2]
         off, advance = _axis_rows(m, follower, bottom)
         return np.vstack(
             (
