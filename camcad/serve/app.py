@@ -399,7 +399,9 @@ class _Handler(BaseHTTPRequestHandler):
         self.timeout = self.server.request_timeout
         super().setup()
         self.rfile.close()
-        self.rfile = io.BufferedReader(_DeadlineReader(self.connection, self.server.request_timeout))
+        self._reader = _DeadlineReader(self.connection, self.server.request_timeout)
+        self.rfile = io.BufferedReader(self._reader)
+        self._unread = False  # a request body not read (drained before the connection is closed)
 
     def log_message(self, format: str, *args: Any) -> None:
         """Quiet: the terminal shows only the address and unexpected errors."""
@@ -413,6 +415,7 @@ class _Handler(BaseHTTPRequestHandler):
     def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
         """Errors of the HTTP layer (bad request line, too long a header, unknown method) as JSON."""
         self.close_connection = True
+        self.request_version = self.protocol_version  # an answer with headers, even to a garbled line
         self._send(code, _error_body(message or HTTPStatus(code).phrase), "application/json")
 
     def _send(self, status: int, body: bytes, kind: str, extra: Mapping[str, str] | None = None) -> None:
@@ -433,6 +436,8 @@ class _Handler(BaseHTTPRequestHandler):
     def _refuse(self, status: int, message: str, extra: Mapping[str, str] | None = None) -> None:
         self.close_connection = True
         self._send(status, _error_body(message), "application/json", extra)
+        if self._unread:
+            self._drain()
 
     # the checks, in the order they are made
 
@@ -483,10 +488,10 @@ class _Handler(BaseHTTPRequestHandler):
         length = int(text)
         if length > MAX_BODY:
             self._refuse(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"{length} bytes; allowed: at most {MAX_BODY}")
-            self._drain()
             return None
         try:
             raw = self.rfile.read(length)
+            self._unread = False
         except TimeoutError:
             self._refuse(HTTPStatus.REQUEST_TIMEOUT, "the body did not arrive in time")
             return None
@@ -517,12 +522,16 @@ class _Handler(BaseHTTPRequestHandler):
         return body
 
     def _drain(self) -> None:
-        """Read (and drop) a little of a refused body, so the client sees the answer rather than a reset."""
+        """Read and drop what the client still sends of a refused request (2 s, 1 MB at most).
+
+        The client then reads the answer rather than a connection reset.
+        """
         with contextlib.suppress(OSError, ValueError):
             self.connection.shutdown(socket.SHUT_WR)
-            left = MAX_BODY
-            while left > 0:
-                chunk = self.rfile.read1(min(left, 65536))
+            left, until = MAX_BODY, min(time.monotonic() + 2.0, self._reader.deadline)
+            while left > 0 and time.monotonic() < until:
+                self.connection.settimeout(max(0.001, min(0.25, until - time.monotonic())))
+                chunk = self.connection.recv(min(left, 65536))
                 if not chunk:
                     break
                 left -= len(chunk)
@@ -568,6 +577,7 @@ class _Handler(BaseHTTPRequestHandler):
         self._send(HTTPStatus.OK, page.encode("utf-8"), "text/html; charset=utf-8")
 
     def _post(self) -> None:
+        self._unread = True
         if not (self._loopback() and self._token(urlsplit(self.path).query) and self._origin()):
             return
         route = urlsplit(self.path).path
@@ -643,6 +653,8 @@ class DesignerServer(socketserver.TCPServer):
         max_pending: int = 512,
         timeout: float = 10.0,
     ) -> None:
+        self._queue: queue.Queue[tuple[socket.socket, Any] | None] = queue.Queue()
+        self._workers: list[threading.Thread] = []  # (server_close runs when the bind fails)
         super().__init__(("127.0.0.1", port), _Handler)
         self.designer = designer
         self.token = secrets.token_urlsafe(32)
@@ -651,7 +663,6 @@ class DesignerServer(socketserver.TCPServer):
         port = self.server_address[1]
         self.origins = frozenset({f"http://127.0.0.1:{port}", f"http://localhost:{port}"})
         self._compute = threading.BoundedSemaphore(analyses)
-        self._queue: queue.Queue[tuple[socket.socket, Any] | None] = queue.Queue()
         self._workers = [
             threading.Thread(target=self._work, name=f"camcad-serve-{i}", daemon=True) for i in range(workers)
         ]
