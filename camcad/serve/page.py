@@ -123,7 +123,7 @@ def render_page(
         '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
         f"<title>camcad designer: {_e(title)}</title>\n"
-        '<link rel="stylesheet" href="/static/designer.css">\n</head>\n'
+        '<link rel="icon" href="data:,">\n<link rel="stylesheet" href="/static/designer.css">\n</head>\n'
         f'<body data-state="loading" data-revision="0" data-stem="{_e(stem)}" data-loaded="{_e(revision)}">\n'
         '<div class="designer">\n'
         f'<form id="design-form" autocomplete="off">{fields}</form>\n'

@@ -587,3 +587,16 @@ def test_a_full_queue_answers_503_at_once(tmp_path):
         _security_headers_of(answer)
         for s in slow:
             s.close()
+
+
+def test_a_design_whose_own_table_leads_out_is_not_served(tmp_path):
+    """The confinement holds for the file's own value too: the server does not start (exit 2 in the CLI)."""
+    from camcad.errors import DesignError
+    from camcad.serve import make_server
+
+    design = _layout(tmp_path)
+    design.write_text(design.read_text().replace('"measured_lift.csv"', '"../secret/creds.txt"'))
+    with pytest.raises(DesignError) as caught:
+        make_server(design)
+    assert caught.value.path == "motion[0].file" and "leads out" in caught.value.message
+    assert SECRET not in str(caught.value)
