@@ -184,7 +184,7 @@ def test_save_refused_when_the_file_changed_on_disk_shows_why(browser, served):
 
 
 def test_the_browser_blocks_nothing_and_the_page_needs_the_token(browser, served):
-    """Under the server's Content-Security-Policy the page loads without a violation; without the token, 403."""
+    """Under the server's Content-Security-Policy the page loads with no console error; no token: 403."""
     url, _ = served
     browser.get(url)
     _wait_for(browser, f"document.body.dataset.state === 'ok' && {SETTLED}", "the first analysis")
