@@ -165,6 +165,14 @@ def _stamp_on_disk(target: Path) -> tuple[int, str] | None:
     return len(raw), hashlib.sha256(raw).hexdigest()
 
 
+def _resolved(path: Path) -> Path | None:
+    """Where ``path`` leads now, links followed (None for a loop or an unreadable folder)."""
+    try:
+        return path.resolve()
+    except (OSError, RuntimeError):
+        return None
+
+
 def _write_atomically(target: Path, text: str) -> tuple[int, str]:
     """Replace ``target`` by ``text`` (UTF-8) atomically, keeping its mode; its new stamp.
 
@@ -257,7 +265,7 @@ class Designer:
         with self.lock:
             if (
                 _stamp_on_disk(self.loaded.target) == self.loaded.stamp
-                and self.path.resolve() == self.loaded.target
+                and _resolved(self.path) == self.loaded.target
             ):
                 self.notice = ""
                 return
@@ -322,9 +330,11 @@ class Designer:
         with self.lock:
             if self.loaded is not loaded:  # loaded anew while this request was validated: the form is old
                 return self._conflict("was loaded again from disk after this form was filled in")
-            now = self.path.resolve()
+            now = _resolved(self.path)
             if now != loaded.target:
-                return self._conflict(f"now leads to {now}, not to the file loaded ({loaded.target})")
+                return self._conflict(
+                    f"now leads to {now or 'no readable file'}, not to the file loaded ({loaded.target})"
+                )
             if _stamp_on_disk(loaded.target) != loaded.stamp:
                 return self._conflict("changed on disk since it was loaded")
             try:
