@@ -70,17 +70,18 @@ def distance_to_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
 
 
 @contextmanager
-def serving(folder: Path) -> Iterator[tuple[Any, str, Path]]:
+def serving(folder: Path, **options: Any) -> Iterator[tuple[Any, str, Path]]:
     """``camcad serve`` on a free loopback port, in a thread, editing a copy of a shipped sample.
 
-    The copy of quintero_vap_b01 is ``folder``/cam.toml. Yields the server, its URL and the design
-    file; shuts the server down afterwards.
+    The copy of quintero_vap_b01 is ``folder``/cam.toml. Yields the server, its URL (with the token)
+    and the design file; shuts the server down afterwards. ``options`` go to
+    :class:`camcad.serve.DesignerServer` (workers, analyses, max_pending, timeout).
     """
     from camcad.serve import make_server
 
     design = folder / "cam.toml"
     shutil.copy(ROOT / "samples" / "quintero_vap_b01.toml", design)
-    srv, url = make_server(design, port=0)
+    srv, url = make_server(design, port=0, **options)
     threading.Thread(target=srv.serve_forever, daemon=True).start()
     try:
         yield srv, url, design

@@ -9,7 +9,9 @@ library's HTTP server and one page of plain JavaScript drawing SVG (no web
 framework, no CDN, nothing to install beyond camcad). Modules: ``form``
 (fields from the schema, values back to a design mapping, TOML text),
 ``payload`` (the JSON the page draws), ``page`` (HTML, CSS, script),
-``app`` (the server).
+``toml_edit`` (Save: only the changed keys, comments kept), ``app`` (the
+server: loopback only, a per-run token, same-origin POSTs, bounded threads;
+see its docstring and "Security of camcad serve" in the README).
 """
 
 from __future__ import annotations
@@ -17,15 +19,17 @@ from __future__ import annotations
 import webbrowser
 from pathlib import Path
 
-from camcad.serve.app import Designer, make_server
+from camcad.serve.app import Designer, DesignerServer, make_server
 
-__all__ = ["Designer", "make_server", "serve"]
+__all__ = ["Designer", "DesignerServer", "make_server", "serve"]
 
 
 def serve(path: str | Path, *, port: int = 0, open_browser: bool = False) -> None:
     """Serve the designer for ``path`` on 127.0.0.1 until interrupted (Ctrl-C).
 
-    ``port`` 0 takes a free port; ``open_browser`` opens the page in the default browser.
+    ``port`` 0 takes a free port; ``open_browser`` opens the page in the default browser. The
+    address printed carries the run's token (``http://127.0.0.1:PORT/?token=…``): the page and
+    every API call need it.
     """
     server, url = make_server(path, port=port)
     print(f"camcad designer for {path} at {url}  (Ctrl-C to stop)", flush=True)

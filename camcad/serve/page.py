@@ -1,8 +1,12 @@
 """The designer's page: the form (rendered here from :mod:`camcad.serve.form`), styles and script.
 
-One self-contained HTML page with no external references: the script posts
-the form's values to ``/api/analyse`` as the user types (debounced; only the
-latest answer is drawn) and draws the returned cam and curves as SVG.
+One HTML page with no external references; its style sheet and script are
+served beside it (:data:`STATIC`, ``/static/designer.css`` and
+``/static/designer.js``), so the page holds no inline script or style and
+the server's Content-Security-Policy can forbid both. The script posts the
+form's values to ``/api/analyse`` as the user types (debounced; only the
+latest answer is drawn), sending the token of the page's address in the
+``X-Camcad-Token`` header, and draws the returned cam and curves as SVG.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ from importlib import resources
 from camcad.report import CSS
 from camcad.serve.form import Field, Group
 
-__all__ = ["render_page"]
+__all__ = ["STATIC", "render_page"]
 
 
 def _e(text: object) -> str:
@@ -80,7 +84,7 @@ details summary { cursor: pointer; color: var(--muted); font-size: 12.5px; margi
               background: #1f5f9e; color: #fff; cursor: pointer; }
 .bar button.secondary { background: #fff; color: #1f5f9e; }
 #status { color: var(--muted); font-size: 12.5px; }
-#general-error:empty { display: none; }
+#general-error:empty, #notice:empty { display: none; }
 body[data-state="invalid"] #cam-drawing, body[data-state="invalid"] .charts,
 body[data-state="invalid"] #cards { opacity: 0.45; }
 #cam-drawing svg { width: 100%; height: auto; display: block; max-height: 70vh; }
@@ -94,29 +98,45 @@ body[data-state="invalid"] #cards { opacity: 0.45; }
   .designer { grid-template-columns: minmax(0, 1fr); }
   .designer form { max-height: none; position: static; }
 }
+main.designer-main { padding: 0; max-width: none; }
 """
 
-_SCRIPT = (resources.files("camcad.serve") / "static" / "designer.js").read_text(encoding="utf-8")
+_SCRIPT = (resources.files("camcad.serve") / "static" / "designer.js").read_bytes()
+
+STATIC: dict[str, tuple[bytes, str]] = {
+    "/static/designer.js": (_SCRIPT, "text/javascript; charset=utf-8"),
+    "/static/designer.css": ((CSS + _PAGE_CSS).encode("utf-8"), "text/css; charset=utf-8"),
+}
+"""The page's script and style sheet by URL path: (bytes, Content-Type); the same for every design."""
 
 
-def render_page(groups: Sequence[Group], *, title: str, stem: str) -> str:
-    """The whole page for a design's form groups; ``stem`` names the downloaded zip."""
+def render_page(
+    groups: Sequence[Group], *, title: str, stem: str, notice: str = "", revision: str = ""
+) -> str:
+    """The whole page for a design's form groups; ``stem`` names the downloaded zip.
+
+    ``notice`` is shown in the page's error banner from the start (e.g. a design file on disk that
+    no longer reads); ``revision`` names the file's content the form shows (sent back with Save).
+    """
     fields = "".join(_group(g) for g in groups)
     return (
         '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-        f"<title>camcad designer: {_e(title)}</title>\n<style>{CSS}{_PAGE_CSS}</style>\n</head>\n"
-        f'<body data-state="loading" data-revision="0" data-stem="{_e(stem)}">\n<div class="designer">\n'
+        f"<title>camcad designer: {_e(title)}</title>\n"
+        '<link rel="icon" href="data:,">\n<link rel="stylesheet" href="/static/designer.css">\n</head>\n'
+        f'<body data-state="loading" data-revision="0" data-stem="{_e(stem)}" data-loaded="{_e(revision)}">\n'
+        '<div class="designer">\n'
         f'<form id="design-form" autocomplete="off">{fields}</form>\n'
-        '<main style="padding:0;max-width:none">\n'
+        '<main class="designer-main">\n'
         f"<header><h1>{_e(title)}</h1></header>\n"
         '<div class="bar"><button type="button" id="save">Save TOML</button>'
         '<button type="button" class="secondary" id="build">Download shop files (.zip)</button>'
         '<span id="status"></span></div>\n'
+        f'<section class="alert bad" id="notice" role="alert">{_e(notice)}</section>\n'
         '<section class="alert bad" id="general-error" role="alert"></section>\n'
         '<div id="alerts"></div>\n'
         '<section class="glance"><figure id="cam-drawing"><div id="cam-drawing-svg"></div>'
         '<figcaption id="cam-caption"></figcaption></figure><div id="cards"></div></section>\n'
         '<section class="charts" id="charts"></section>\n'
-        f"</main>\n</div>\n<script>{_SCRIPT}</script>\n</body>\n</html>\n"
+        '</main>\n</div>\n<script src="/static/designer.js"></script>\n</body>\n</html>\n'
     )

@@ -153,3 +153,45 @@ def test_save_button_writes_the_design(browser, served):
     browser.find_element("id", "save").click()
     _wait_for(browser, "document.getElementById('status').textContent.startsWith('saved')", "the save")
     assert load_design(path).cam.base_radius == 61.5
+
+
+def test_save_refused_when_the_file_changed_on_disk_shows_why(browser, served):
+    """An edit made on disk while the page is open is not overwritten: 409, and the page says so."""
+    url, path = served
+    browser.set_window_size(1600, 1200)
+    browser.get(url)
+    _wait_for(browser, f"document.body.dataset.state === 'ok' && {SETTLED}", "the first analysis")
+    edited = path.read_text(encoding="utf-8") + "# edited in another editor while the page was open\n"
+    path.write_text(edited, encoding="utf-8")
+    field = browser.find_element("name", "cam.base_radius")
+    field.clear()
+    field.send_keys("47")
+    browser.find_element("id", "save").click()
+    _wait_for(browser, "document.getElementById('status').textContent.startsWith('not saved')", "the refusal")
+    assert browser.find_element("id", "status").text == "not saved: the file changed on disk"
+    assert "changed on disk since it was loaded" in browser.find_element("id", "general-error").text
+    assert path.read_text(encoding="utf-8") == edited
+    # reloading the page loads the file as it is now; Save then writes it, the comment kept
+    browser.get(url)
+    _wait_for(browser, f"document.body.dataset.state === 'ok' && {SETTLED}", "the reload")
+    field = browser.find_element("name", "cam.base_radius")
+    field.clear()
+    field.send_keys("47")
+    browser.find_element("id", "save").click()
+    _wait_for(browser, "document.getElementById('status').textContent.startsWith('saved')", "the save")
+    assert load_design(path).cam.base_radius == 47.0
+    assert path.read_text(encoding="utf-8").endswith("# edited in another editor while the page was open\n")
+
+
+def test_the_browser_blocks_nothing_and_the_page_needs_the_token(browser, served):
+    """Under the server's Content-Security-Policy the page loads with no console error; no token: 403."""
+    url, _ = served
+    browser.get(url)
+    _wait_for(browser, f"document.body.dataset.state === 'ok' && {SETTLED}", "the first analysis")
+    browser.get_log("browser")  # what earlier tests left
+    browser.refresh()
+    _wait_for(browser, f"document.body.dataset.state === 'ok' && {SETTLED}", "the reload")
+    severe = [e["message"] for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+    assert severe == []
+    browser.get(url.split("?")[0])
+    assert "a valid token is required" in browser.find_element("tag name", "body").text

@@ -106,7 +106,7 @@ def server(tmp_path):
 
 def _request(srv, method, path, body=None, *, host="127.0.0.1", kind="application/json"):
     conn = http.client.HTTPConnection("127.0.0.1", srv.server_address[1], timeout=60)
-    headers = {"Host": f"{host}:{srv.server_address[1]}", "Content-Type": kind}
+    headers = {"Host": f"{host}:{srv.server_address[1]}", "Content-Type": kind, "X-Camcad-Token": srv.token}
     conn.request(method, path, body=None if body is None else json.dumps(body), headers=headers)
     response = conn.getresponse()
     return response.status, response.getheader("Content-Type"), response.read()

@@ -1,6 +1,8 @@
 "use strict";
 const form = document.getElementById("design-form");
 const status = document.getElementById("status");
+// The per-run token the server printed in the page's address: sent with every API call.
+const TOKEN = new URLSearchParams(location.search).get("token") || "";
 let sent = 0, drawn = 0, timer = null, waiting = false;
 
 function settle() {  // "1" while a change is not yet drawn (tests and screen readers wait on it)
@@ -132,7 +134,18 @@ function render(out) {
 }
 
 async function post(url, body) {
-  return fetch(url, {method: "POST", headers: {"Content-Type": "application/json"}, body: JSON.stringify(body)});
+  return fetch(url, {
+    method: "POST", credentials: "omit", cache: "no-store",
+    headers: {"Content-Type": "application/json", "X-Camcad-Token": TOKEN},
+    body: JSON.stringify(body),
+  });
+}
+async function answer(response) {  // the JSON of any answer, or an error in the same shape
+  try { return await response.json(); }
+  catch (err) { return {ok: false, errors: [{field: "", message: "the server sent no answer (" + response.status + ")"}]}; }
+}
+function unreachable() {
+  return {ok: false, errors: [{field: "", message: "the designer server is not reachable (was camcad serve stopped?)"}]};
 }
 
 let notes = 0;  // counts save and build messages: an analysis that began before one does not overwrite it
@@ -144,8 +157,8 @@ async function analyse() {
   settle();
   status.textContent = "analysing…";
   const started = performance.now();
-  const response = await post("/api/analyse", {values: values()});
-  const out = await response.json();
+  let out;
+  try { out = await answer(await post("/api/analyse", {values: values()})); } catch (err) { out = unreachable(); }
   if (id !== sent) return;  // a newer change is on its way
   render(out);
   drawn = id;
@@ -161,17 +174,22 @@ form.addEventListener("input", () => later(150));
 form.addEventListener("change", () => later(0));
 form.addEventListener("submit", ev => ev.preventDefault());
 document.getElementById("save").addEventListener("click", async () => {
-  const out = await (await post("/api/save", {values: values()})).json();
+  let out;
+  try { out = await answer(await post("/api/save", {values: values(), loaded: document.body.dataset.loaded})); } catch (err) { out = unreachable(); }
   if (out.errors) showErrors(out.errors);
+  if (out.revision) document.body.dataset.loaded = out.revision;  // the file as saved is the one now loaded
   notes++;
-  status.textContent = out.saved ? "saved " + out.saved : "not saved: fix the fields marked";
+  status.textContent = out.saved ? "saved " + out.saved
+    : out.conflict ? "not saved: the file changed on disk" : "not saved: fix the fields marked";
 });
 document.getElementById("build").addEventListener("click", async () => {
   notes++;
   status.textContent = "building the shop files…";
-  const response = await post("/api/build", {values: values()});
+  let response;
+  try { response = await post("/api/build", {values: values()}); }
+  catch (err) { showErrors(unreachable().errors); notes++; status.textContent = "not built"; return; }
   if (!response.ok) {
-    const out = await response.json(); showErrors(out.errors); notes++; status.textContent = "not built"; return;
+    const out = await answer(response); showErrors(out.errors || []); notes++; status.textContent = "not built"; return;
   }
   const blob = await response.blob();
   const link = document.createElement("a");
