@@ -26,7 +26,9 @@ from camcad.dynamics.film import entraining_speed
 from camcad.geometry.envelope import to_cam
 
 if TYPE_CHECKING:
-    from camcad.geometry.cam import Cam, CamState
+    from camcad.geometry.cam import Cam
+    from camcad.geometry.curves import CurveSample
+    from camcad.motion.program import Motion
 
 __all__ = ["ContactMotion", "contact_motion"]
 
@@ -60,7 +62,14 @@ class ContactMotion:
     rolling: bool
 
 
-def contact_motion(cam: Cam, phi: ArrayLike, *, omega: float, state: CamState | None = None) -> ContactMotion:
+def contact_motion(
+    cam: Cam,
+    phi: ArrayLike,
+    *,
+    omega: float,
+    profile: CurveSample | None = None,
+    motion: Motion | None = None,
+) -> ContactMotion:
     """The contact's speeds at cam angles φ.
 
     Parameters
@@ -71,8 +80,8 @@ def contact_motion(cam: Cam, phi: ArrayLike, *, omega: float, state: CamState | 
         (n,) cam angles [rad].
     omega
         Cam speed ω [rad/s].
-    state
-        ``cam.state(phi)`` if already computed.
+    profile, motion
+        ``cam.profile(phi)`` and ``cam.motion(phi)`` if already computed.
 
     Returns
     -------
@@ -85,20 +94,21 @@ def contact_motion(cam: Cam, phi: ArrayLike, *, omega: float, state: CamState | 
     flat tappet; Rothbart 2004, §9.7).
     """
     p = np.asarray(phi, dtype=float).ravel()
-    st = cam.state(p) if state is None else state
-    d1 = np.asarray(st.profile.d1, dtype=float)
-    tangent = np.asarray(st.profile.tangent, dtype=float)
+    prof = cam.profile(p) if profile is None else profile
+    d1 = np.asarray(prof.d1, dtype=float)
+    tangent = np.asarray(prof.tangent, dtype=float)
     arc = np.hypot(d1[:, 0], d1[:, 1])
     w = np.einsum("ij,ij->i", d1, tangent) * omega  # signed along t (≥ 0 but at a cusp)
     if cam.is_roller:
         slip = np.zeros_like(p)
     else:
         sigma = cam.sigma
-        contact = to_cam(p, np.asarray(st.profile.point, dtype=float), -sigma)  # machine frame
+        contact = to_cam(p, np.asarray(prof.point, dtype=float), -sigma)  # machine frame
         t_machine = to_cam(p, tangent, -sigma)
         guide = cam.kinematics.guide
         direction = guide.driven(contact)
-        rate = np.asarray(st.motion.v, dtype=float) * omega  # ṡ [mm/s] or ψ̇ [deg/s]
+        m = cam.motion(p) if motion is None else motion
+        rate = np.asarray(m.v, dtype=float) * omega  # ṡ [mm/s] or ψ̇ [deg/s]
         if guide.pivot is not None:
             lever = np.hypot(*(contact - np.asarray(guide.pivot, dtype=float)).T)
             rate = np.radians(rate) * lever  # ψ̇ r: the arm's point at the contact [mm/s]

@@ -154,7 +154,7 @@ def test_checks_pass_and_fail_per_line():
     lines = {c.name: c for c in r.checks}
     assert lines["peak torque"].value == pytest.approx(4.0 / (2.0 * 0.9), rel=1e-9)
     assert lines["peak torque"].ok is False
-    assert lines["motor speed"].value == pytest.approx(240.0) and lines["motor speed"].ok is False
+    assert lines["speed"].value == pytest.approx(240.0) and lines["speed"].ok is False
     assert (
         lines["inertia ratio"].value == pytest.approx(0.05 / 4.0 / 1e-3)
         and lines["inertia ratio"].ok is False
