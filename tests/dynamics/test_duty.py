@@ -169,3 +169,19 @@ def test_no_tables_no_duty():
     assert analysis.duty is None
     assert not {"life", "lubrication", "drive"} & set(analysis.summary())
     assert np.all(np.isfinite(analysis.dynamics.torque))
+
+
+def test_explore_measures_read_the_new_sections():
+    """roller_life_h, min_film_ratio, motor_rms_torque for optimise and sweep; None without the table."""
+    from camcad.explore.measures import measure_values, parse_limit
+
+    analysis = pipeline.analyse(load_design(SAMPLE), fit=False, toolpath=False, strict=False)
+    values = measure_values(analysis)
+    summary = analysis.summary()
+    assert values["roller_life_h"] == summary["life"]["roller_life_h"]
+    assert values["min_film_ratio"] == summary["lubrication"]["min_film_ratio"]
+    assert values["motor_rms_torque_Nm"] == summary["drive"]["motor_rms_torque_Nm"]
+    assert parse_limit("min_film_ratio>=1").holds(values)
+    assert not parse_limit("motor_rms_torque<=0.01").holds(values)
+    plain = measure_values(_analyse(_data()))
+    assert plain["roller_life_h"] is None and plain["min_film_ratio"] is None
