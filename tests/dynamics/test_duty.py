@@ -185,3 +185,15 @@ def test_explore_measures_read_the_new_sections():
     assert not parse_limit("motor_rms_torque<=0.01").holds(values)
     plain = measure_values(_analyse(_data()))
     assert plain["roller_life_h"] is None and plain["min_film_ratio"] is None
+
+
+def test_report_has_a_figure_per_analysis():
+    from camcad.report import render_report
+
+    html = render_report(pipeline.analyse(load_design(SAMPLE), fit=False, toolpath=False, strict=False))
+    for key in ("plot-life", "plot-film", 'plot-drive"', "plot-drive-envelope", "table-life", "table-drive"):
+        assert key in html
+    flat = _analyse(_data(follower={"type": "translating-flat"}, life=LIFE))
+    html = render_report(flat)
+    assert "rolling life does not apply" in html
+    assert "duty-heading" not in render_report(_analyse(_data()))
