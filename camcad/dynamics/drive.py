@@ -50,6 +50,7 @@ from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
 from camcad.dynamics._cycle import cycle_mean, cycle_weights
 from camcad.errors import DesignError
+from camcad.extremes import Extreme
 from camcad.findings import Finding, Severity
 from camcad.motion.segments import SegmentKind
 
@@ -280,6 +281,7 @@ def analyse_drive(
     omega: float,
     spec: DriveSpec,
     load_inertia: ArrayLike | float = 0.0,
+    load_extremes: tuple[Extreme, Extreme] | None = None,
 ) -> DriveResult:
     """Motor torque, speed and inertia over the cycle, checked against the motor.
 
@@ -305,6 +307,12 @@ def analyse_drive(
         (n,) or scalar: the load's inertia at the axis besides the camshaft's
         own (the follower's equivalent inertia m·(ds/dφ)² on a camshaft
         [kg·m²]; the follower mass on a slide [kg]; the arm's inertia [kg·m²]).
+    load_extremes
+        Camshaft mode: the true (min, max) of the cam torque over the turn
+        (one-sided limits at joints included, e.g. ``DynamicsResult.torque_min``
+        and ``torque_max``). The motor torque is T/(iη) for T ≥ 0 and Tη/i
+        below, increasing in T, so its peak |T_m| is reached at one of them:
+        the peak reported is then the true one, not the samples'.
 
     Returns
     -------
@@ -341,7 +349,13 @@ def analyse_drive(
             j_load = j_load + spec.camshaft_inertia_kg_m2
         ratio = float(j_load / k_si**2 / spec.motor_inertia_kg_m2)
     readonly(p, torque, motor_rpm, load)
-    peak, rms_t, top = float(abs(torque[i])), rms(p, torque), float(np.max(motor_rpm))
+    peak, peak_angle = float(abs(torque[i])), float(p[i])
+    if load_extremes is not None and spec.mode is DriveMode.CAMSHAFT:
+        for ext in load_extremes:  # T_m is increasing in T: its extremes sit at T's
+            t = float(motor_torque([ext.value], [1.0], transmission=k, efficiency=spec.gear_efficiency)[0])
+            if abs(t) > peak:
+                peak, peak_angle = abs(t), ext.phi
+    rms_t, top = rms(p, torque), float(np.max(motor_rpm))
     checks = (
         DriveCheck(name="peak torque", value=peak, limit=spec.motor_peak_torque_Nm, unit="N·m"),
         DriveCheck(name="RMS torque", value=rms_t, limit=spec.motor_rated_torque_Nm, unit="N·m"),
@@ -359,13 +373,13 @@ def analyse_drive(
         motor_speed_rpm=motor_rpm,
         axis_load=load,
         peak_torque=peak,
-        peak_angle=float(p[i]),
+        peak_angle=peak_angle,
         rms_torque=rms_t,
         max_speed_rpm=top,
         inertia_ratio=ratio,
         regenerated_energy_J=regen,
         checks=checks,
-        findings=_findings(checks, peak_angle=float(p[i])),
+        findings=_findings(checks, peak_angle=peak_angle),
     )
 
 
@@ -444,7 +458,8 @@ def _law_maxima(law: Law, pieces: list[tuple[float, float]]) -> tuple[float, flo
     def quantities(x: FloatArray) -> FloatArray:
         d = law.evaluate(x)
         y1, y2, y3 = (np.asarray(d[k], dtype=float) for k in (1, 2, 3))
-        return np.abs(np.vstack((y1, y2, y3, y1 * y2)))  # VDI 2143: C_v, C_a, C_j, C_Mdyn
+        out: FloatArray = np.abs(np.vstack((y1, y2, y3, y1 * y2)))  # VDI 2143: C_v, C_a, C_j, C_Mdyn
+        return out
 
     grids = []
     for lo, hi in pieces:

@@ -20,12 +20,14 @@ life (its roller is: the roller's load is |F|).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from camcad._typing import FloatArray
+from camcad.angles import TWO_PI
 from camcad.dynamics.arm import arm_speed
 from camcad.dynamics.contact import contact_curvature, effective_modulus
 from camcad.dynamics.drive import (
@@ -37,25 +39,35 @@ from camcad.dynamics.drive import (
     segment_characteristics,
 )
 from camcad.dynamics.energy import FollowerLoad
-from camcad.dynamics.film import FilmResult, LubricationSpec, analyse_film
+from camcad.dynamics.film import (
+    FilmResult,
+    LubricationSpec,
+    analyse_film,
+    film_findings,
+    film_ratio,
+    minimum_film_thickness,
+    reduced_modulus,
+)
 from camcad.dynamics.life import (
     LifeSpec,
     RollerLife,
     TrackLife,
     life_findings,
+    load_stress_factor,
     roller_life,
     summary_entry,
     track_life,
 )
-from camcad.dynamics.model import _arm_load
+from camcad.dynamics.model import _arm_load, _model
 from camcad.dynamics.rolling import ContactMotion, contact_motion
 from camcad.dynamics.spring import spring_from_spec
+from camcad.extremes import Side, maximum, minimum
 from camcad.findings import Finding
 
 if TYPE_CHECKING:
     from camcad.dynamics.results import DynamicsResult
     from camcad.dynamics.spec import DynamicsSetup
-    from camcad.geometry.cam import Cam
+    from camcad.geometry.cam import Cam, CamState
     from camcad.geometry.curves import CurveSample
 
 __all__ = ["DutyResult", "analyse_duty"]
@@ -180,6 +192,7 @@ def analyse_duty(
             track = track_life(
                 phi, force, curvature=curvature, length=setup.contact_length, omega=omega, spec=life
             )
+            track = _exact_track(cam, setup, phi, track, life)
         findings += life_findings(life, roller=roller, track=track)
     film = None
     if lubrication is not None:
@@ -198,6 +211,7 @@ def analyse_duty(
             contact_modulus=modulus,
             spec=lubrication,
         )
+        film = _exact_film(cam, setup, film, lubrication, modulus)
         findings += film.findings
     result = None
     characteristics: tuple[tuple[int, str, CharacteristicValues], ...] = ()
@@ -217,6 +231,80 @@ def analyse_duty(
     )
 
 
+def _joints(cam: Cam) -> list[float]:
+    return [bp.phi for bp in cam.program.breakpoints]
+
+
+def _pointwise(cam: Cam, setup: DynamicsSetup) -> Callable[[FloatArray, Side], tuple[CamState, FloatArray]]:
+    """The exact cam state and contact force at any angles (the rigid model, one-sided at joints)."""
+    model = _model(setup)
+
+    def at(p: FloatArray, side: Side) -> tuple[CamState, FloatArray]:
+        st = cam.state(p, side=side)
+        return st, model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force
+
+    return at
+
+
+def _exact_film(
+    cam: Cam, setup: DynamicsSetup, film: FilmResult, spec: LubricationSpec, modulus: float
+) -> FilmResult:
+    """The true smallest film ratio λ over the turn: the samples' refined on the exact cam."""
+    at = _pointwise(cam, setup)
+    roller = setup.roller_radius or None
+
+    def ratio(p: FloatArray, side: Side) -> FloatArray:
+        st, force = at(p, side)
+        u = contact_motion(cam, p, omega=setup.omega, profile=st.profile, motion=st.motion).entraining_speed
+        h = minimum_film_thickness(
+            load_per_length=force / setup.contact_length,
+            speed=u,
+            curvature=contact_curvature(st.profile.rho, roller_radius=roller),
+            modulus=reduced_modulus(modulus),
+            viscosity_Pa_s=spec.viscosity_Pa_s,
+            pressure_viscosity_coefficient=spec.pressure_viscosity_coefficient,
+        )
+        rq = (spec.roughness_cam_um, spec.roughness_follower_um)
+        return film_ratio(h * 1e3, roughness_cam_um=rq[0], roughness_follower_um=rq[1])
+
+    if not np.isfinite(film.min_ratio):
+        return film
+    low = minimum(ratio, film.phi, _joints(cam), values=film.ratio)
+    if not low.value < film.min_ratio:
+        return film
+    exact = replace(
+        film, min_ratio=low.value, angle=low.phi, min_thickness_um=low.value * spec.composite_roughness_um
+    )
+    return replace(exact, findings=film_findings(exact))
+
+
+def _exact_track(
+    cam: Cam, setup: DynamicsSetup, phi: FloatArray, track: TrackLife, spec: LifeSpec
+) -> TrackLife:
+    """The track's true largest load-stress factor (and so its life), refined on the exact cam."""
+    at = _pointwise(cam, setup)
+    roller = setup.roller_radius or None
+
+    def factor(p: FloatArray, side: Side) -> FloatArray:
+        st, force = at(p, side)
+        curvature = contact_curvature(st.profile.rho, roller_radius=roller)
+        return load_stress_factor(force, curvature=curvature, length=setup.contact_length)
+
+    high = maximum(factor, phi, _joints(cam), values=track.factor)
+    if spec.track is None or not high.value > track.factor_max:
+        return track
+    cycles = float(spec.track.cycles(high.value))
+    hours = cycles * TWO_PI / setup.omega / 3600.0
+    return replace(
+        track,
+        factor_max=high.value,
+        angle=high.phi,
+        cycles=cycles,
+        hours=hours,
+        days=None if spec.hours_per_day is None else hours / spec.hours_per_day,
+    )
+
+
 def _drive(cam: Cam, dynamics: DynamicsResult, *, setup: DynamicsSetup, spec: DriveSpec) -> DriveResult:
     """The motor's duty: the camshaft's, or the follower axis' of an electronic cam."""
     phi = dynamics.phi
@@ -228,6 +316,9 @@ def _drive(cam: Cam, dynamics: DynamicsResult, *, setup: DynamicsSetup, spec: Dr
         # the follower's equivalent inertia at the camshaft: I·ψ′² or m·s′² [kg·m²]
         follower = dyn.arm_inertia if arm else dyn.follower_mass
         equivalent = follower * speed**2 / _MM2_PER_M2
+        extremes = None
+        if dynamics.torque_min is not None and dynamics.torque_max is not None:
+            extremes = (dynamics.torque_min, dynamics.torque_max)
         return analyse_drive(
             phi,
             axis_load=dynamics.torque,
@@ -236,6 +327,7 @@ def _drive(cam: Cam, dynamics: DynamicsResult, *, setup: DynamicsSetup, spec: Dr
             omega=setup.omega,
             spec=spec,
             load_inertia=equivalent,
+            load_extremes=extremes,
         )
     if arm:
         load = _arm_load(setup).axial_force(motion, omega=setup.omega)  # N·mm about the pivot

@@ -197,3 +197,24 @@ def test_report_has_a_figure_per_analysis():
     html = render_report(flat)
     assert "rolling life does not apply" in html
     assert "duty-heading" not in render_report(_analyse(_data()))
+
+
+def test_extremes_are_true_on_a_coarse_grid():
+    """Smallest λ, largest K, peak motor torque: a 3° grid refined on the exact cam gives the 0.01° grid's."""
+    tables = {
+        "life": {"track_slope": 8.0, "track_intercept": 34.0},
+        "lubrication": OIL,
+        "drive": {"gear_ratio": 5.0, "gear_efficiency": 0.8},
+    }
+    data = _data(**tables)
+    data["motion"] = [
+        {"kind": "rise", "angle": 170.0, "lift": 25.0, "law": "modified-sine"},
+        {"kind": "return", "angle": 190.0, "lift": 25.0, "law": "cycloidal"},
+    ]
+    coarse = _analyse({**data, "cam": {**data["cam"], "sample_step_deg": 3.0}}).duty
+    fine = _analyse({**data, "cam": {**data["cam"], "sample_step_deg": 0.01}}).duty
+    assert coarse.film.min_ratio == pytest.approx(fine.film.min_ratio, rel=1e-7)
+    assert coarse.film.min_ratio <= np.min(coarse.film.ratio)
+    assert coarse.track.factor_max == pytest.approx(fine.track.factor_max, rel=1e-7)
+    assert coarse.drive.peak_torque == pytest.approx(fine.drive.peak_torque, rel=1e-7)
+    assert coarse.drive.peak_torque >= np.max(np.abs(coarse.drive.motor_torque))
