@@ -26,6 +26,7 @@ from camcad.motion.table import table_summary
 from camcad.positive import PositiveDrive
 
 if TYPE_CHECKING:
+    from camcad.dynamics.duty import DutyResult
     from camcad.export.gcode import GcodeProgram
     from camcad.fea.results import FeaResult  # only typing: the FE package loads when the check runs
     from camcad.toolpath import Toolpath
@@ -71,6 +72,7 @@ class Analysis:
     stage_findings: tuple[Finding, ...] = ()
     positive: PositiveDrive = field(default_factory=PositiveDrive)
     fea: FeaResult | None = None  # the finite-element check, when run ([fea] present, or asked for)
+    duty: DutyResult | None = None  # life, film and drive ([life], [lubrication], [drive]; issue 35)
 
     @property
     def findings(self) -> tuple[Finding, ...]:
@@ -81,6 +83,7 @@ class Analysis:
             *self.dynamics.findings,
             *self.stage_findings,
             *(self.fea.findings if self.fea is not None else ()),
+            *(self.duty.findings if self.duty is not None else ()),
         )
         return tuple(sorted(found, key=lambda f: not f.hard))
 
@@ -88,7 +91,8 @@ class Analysis:
     def warnings(self) -> list[str]:
         """Every non-fatal message of every stage: soft findings and notes."""
         fea = list(self.fea.warnings) if self.fea is not None else []
-        return [*self.geometry.warnings, *self.dynamics.warnings, *fea]
+        duty = [f.message for f in self.duty.findings] if self.duty is not None else []
+        return [*self.geometry.warnings, *self.dynamics.warnings, *fea, *duty]
 
     @property
     def violations(self) -> list[str]:
@@ -111,6 +115,8 @@ class Analysis:
             out["gcode"] = self.gcode.summary()
         if self.fea is not None:
             out["fea"] = self.fea.summary()
+        if self.duty is not None:
+            out |= self.duty.summary()  # life, lubrication, drive
         out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]

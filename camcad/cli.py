@@ -142,6 +142,45 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
     ]
 
 
+def _duty_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+    """The rows ``[life]``, ``[lubrication]`` and ``[drive]`` add to ``camcad check`` (issue 35)."""
+    rows: list[tuple[str, str]] = []
+    life, film, drive = summary.get("life"), summary.get("lubrication"), summary.get("drive")
+    if life is not None and "sliding_speed_max_mm_per_s" in life:
+        rows.append(
+            ("rolling life", f"n/a: the face slides (max {life['sliding_speed_max_mm_per_s']:.1f} mm/s)")
+        )
+    if life is not None and "roller_life_h" in life:
+        hours = life["roller_life_h"]
+        rows.append(
+            (
+                "roller L10 life",
+                ("unloaded" if hours is None else f"{hours:.4g} h")
+                + f" (P {life['roller_equivalent_load_N']:.1f} N,"
+                + f" {life['roller_turns_per_cam_turn']:.3f} roller turns a turn)",
+            )
+        )
+    if life is not None and "track_life_h" in life:
+        hours = life["track_life_h"]
+        rows.append(("track life", "unloaded" if hours is None else f"{hours:.4g} h"))
+    if film is not None:
+        rows.append(
+            (
+                "min film ratio λ",
+                _fmt(film["min_film_ratio"], "", 2)
+                + _at(film, "min_film_ratio")
+                + f" (limit {film['film_ratio_limit']:g})",
+            )
+        )
+    if drive is not None:
+        for line in drive["checks"]:
+            verdict = "" if line["ok"] is None else (" ok" if line["ok"] else " FAILS")
+            limit = "" if line["limit"] is None else f" (limit {line['limit']:g})"
+            unit = "" if line["unit"] == "1" else f" {line['unit']}"
+            rows.append((f"motor {line['name']}", f"{line['value']:.4g}{unit}{limit}{verdict}"))
+    return rows
+
+
 def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     """The rows a groove or a conjugate pair adds to ``camcad check``: flanks, second plate, crossovers."""
     rows: list[tuple[str, str]] = []
@@ -198,6 +237,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     design = load_design(args.design)
     analysis = analyse(design, strict=False, toolpath=True, fea=args.fea or design.fea is not None)
     rows = _check_rows(analysis.summary(), design) + _positive_rows(analysis.summary())
+    rows += _duty_rows(analysis.summary())
     if analysis.fea is not None:
         rows += _fea_rows(analysis.summary()["fea"])
     width = max(len(k) for k, _ in rows)

@@ -179,6 +179,24 @@ def analyse(
             cam=cam,
         ),
     )
+    duty = None
+    if design.life is not None or design.lubrication is not None or design.drive is not None:
+        from camcad.dynamics.duty import analyse_duty
+
+        duty = _timed(
+            timings,
+            progress,
+            "duty",
+            lambda: analyse_duty(
+                cam,
+                dynamics,
+                setup=design.dynamics_setup(),
+                profile=geometry.profile,
+                life=design.life,
+                lubrication=design.lubrication,
+                drive=design.drive,
+            ),
+        )
     later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
     fitted = planned = None
     if fit and not hard:
@@ -261,6 +279,7 @@ def analyse(
         stage_findings=tuple(later),
         positive=positive,
         fea=fea_result,
+        duty=duty,
     )
 
 
@@ -632,6 +651,7 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
             "contact_force_N": dyn.contact_force,
             "torque_Nmm": dyn.torque,
             "hertz_stress_MPa": dyn.hertz_stress,
+            **(analysis.duty.csv_columns() if analysis.duty is not None else {}),
         },
     )
     return [

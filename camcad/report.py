@@ -514,6 +514,21 @@ def _fea_section(analysis: Analysis) -> str:
     )
 
 
+def _duty_section(analysis: Analysis) -> str:
+    """Life, lubricant film and drive (issue 35): a figure each; their numbers are in the tables."""
+    duty = getattr(analysis, "duty", None)
+    if duty is None:
+        return ""
+    from camcad._plots.duty import duty_plots
+
+    figures = "".join(_img(p) for p in duty_plots(analysis))
+    return (
+        '<h2 id="duty-heading">Life, lubrication and drive</h2>\n<section id="duty">'
+        "<p>The numbers are in the tables <i>Life</i>, <i>Lubrication</i> and <i>Drive</i> below.</p>"
+        f'<section class="plots">{figures}</section></section>'
+    )
+
+
 def render_report(analysis: Analysis) -> str:
     """The HTML report of one analysed design.
 
@@ -559,6 +574,7 @@ def render_report(analysis: Analysis) -> str:
             glance,
             f'<h2 id="plots-heading">Plots</h2>\n<section class="plots" id="plots">{rest}</section>',
             _fea_section(analysis),
+            _duty_section(analysis),
             "<h2>Tables</h2>",
             _summary_tables(analysis, summary),
             f"<footer>camcad {_e(version)} · angles in degrees, lengths in mm</footer>",

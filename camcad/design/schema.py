@@ -36,6 +36,9 @@ from typing import Any
 import numpy as np
 
 from camcad.design.spec import DEG, CamSpec, Design, Dialect, Direction, GcodeSpec
+from camcad.dynamics.drive import DriveMode, DriveSpec
+from camcad.dynamics.film import LubricationSpec
+from camcad.dynamics.life import ROLLER_EXPONENT, LifeSpec, LoadStressLine
 from camcad.dynamics.spec import DynamicsModel, DynamicsSpec
 from camcad.errors import DesignError
 from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
@@ -217,6 +220,13 @@ def _fea_angles(v: tuple[float, ...]) -> str | None:
     return f"has {bad[0]:g}; allowed: cam angles 0 to 360 degrees" if bad else None
 
 
+def _life_exponent(v: float) -> str | None:
+    """ISO 281: p = 3 (ball) or 10/3 (needle and roller; 3.333 in a file is read as 10/3)."""
+    if v == 3.0 or abs(v - ROLLER_EXPONENT) < 1e-3:
+        return None
+    return "must be 3 (ball bearing) or 10/3 ≈ 3.333 (needle or roller bearing, ISO 281)"
+
+
 _MESH_FORMATS = ("stl", "obj", "ply", "off", "3mf", "vtu")
 
 
@@ -323,6 +333,34 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "contact_divisions": _Rule("int", check=_count(2, 64, "element edges across the contact strip")),
         "growth": _Rule("float", check=_between(0.05, 1.0, " mm/mm")),
         "keyway_fillet": _Rule("float", check=_length),
+    },
+    "life": {  # issue 35: the track roller's L10 and the track's surface fatigue (camcad.dynamics.life)
+        "roller_dynamic_load_rating": _Rule("float", check=_between(0.0, MAX_FORCE_N, " N", lo_open=True)),
+        "roller_life_exponent": _Rule("float", check=_life_exponent),
+        "hours_per_day": _Rule("float", check=_between(0.0, 24.0, " h", lo_open=True)),
+        "required_hours": _Rule("float", check=_between(0.0, 1e9, " h", lo_open=True)),
+        "track_slope": _Rule("float", check=_between(0.0, 1e3, " (A of Rothbart eq. 9.15)", lo_open=True)),
+        "track_intercept": _Rule("float", check=_between(-1e3, 1e3, " (B of Rothbart eq. 9.15)")),
+    },
+    "lubrication": {  # issue 35: Dowson-Higginson film (camcad.dynamics.film)
+        "viscosity_Pa_s": _Rule("float", check=_between(0.0, 1e4, " Pa·s", lo_open=True)),
+        "pressure_viscosity_coefficient": _Rule("float", check=_between(0.0, 1e-6, " 1/Pa", lo_open=True)),
+        "roughness_cam_um": _Rule("float", check=_between(0.0, 1e3, " µm (Rq)", lo_open=True)),
+        "roughness_follower_um": _Rule("float", check=_between(0.0, 1e3, " µm (Rq)", lo_open=True)),
+        "min_film_ratio": _Rule("float", check=_between(0.0, 100.0, "", lo_open=True)),
+    },
+    "drive": {  # issue 35: motor and gearbox, or the servo axis of an electronic cam (camcad.dynamics.drive)
+        "mode": _Rule("enum", enum=DriveMode),
+        "gear_ratio": _Rule("float", check=_between(0.0, 1e6, "", lo_open=True)),
+        "gear_efficiency": _Rule("float", check=_between(0.0, 1.0, "", lo_open=True)),
+        "motor_rated_torque_Nm": _Rule("float", check=_between(0.0, 1e6, " N·m", lo_open=True)),
+        "motor_peak_torque_Nm": _Rule("float", check=_between(0.0, 1e6, " N·m", lo_open=True)),
+        "motor_max_rpm": _Rule("float", check=_between(0.0, 1e6, " rpm", lo_open=True)),
+        "motor_inertia_kg_m2": _Rule("float", check=_between(0.0, 1e3, " kg·m²", lo_open=True)),
+        "camshaft_inertia_kg_m2": _Rule("float", check=_between(0.0, 1e3, " kg·m²")),
+        "max_inertia_ratio": _Rule("float", check=_between(0.0, 1e6, "", lo_open=True)),
+        "screw_lead_mm": _Rule("float", check=_length),
+        "axis_friction": _Rule("float", check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N or N·mm")),
     },
     "tables": {
         "step_deg": _Rule("float", check=_table_step, scale=DEG, attr="step"),
@@ -695,6 +733,54 @@ def _check_program(segments: tuple[SegmentSpec, ...], *, unit: str = " mm") -> N
         )
 
 
+def _service_tables(data: Mapping[str, Any]) -> dict[str, Any]:
+    """The optional ``[life]``, ``[lubrication]`` and ``[drive]`` tables (issue 35), those present."""
+    out: dict[str, Any] = {}
+    if "life" in data:
+        kw = _section("life", data["life"])
+        slope, intercept = kw.pop("track_slope", None), kw.pop("track_intercept", None)
+        if (slope is None) != (intercept is None):
+            missing = "track_intercept" if intercept is None else "track_slope"
+            raise DesignError(
+                f"life.{missing}", "the track's K–N line needs both track_slope and track_intercept"
+            )
+        if slope is not None:
+            kw["track"] = LoadStressLine(slope=slope, intercept=intercept, source="user")
+        if abs(kw.get("roller_life_exponent", ROLLER_EXPONENT) - ROLLER_EXPONENT) < 1e-3:
+            kw["roller_life_exponent"] = ROLLER_EXPONENT  # 3.333 in a file means 10/3
+        out["life"] = LifeSpec(**kw)
+    if "lubrication" in data:
+        kw = _section("lubrication", data["lubrication"])
+        for key in (
+            "viscosity_Pa_s",
+            "pressure_viscosity_coefficient",
+            "roughness_cam_um",
+            "roughness_follower_um",
+        ):
+            if key not in kw:
+                raise DesignError(f"lubrication.{key}", "is required in a [lubrication] table")
+        out["lubrication"] = LubricationSpec(**kw)
+    if "drive" in data:
+        out["drive"] = DriveSpec(**_section("drive", data["drive"]))
+    return out
+
+
+def _check_service(design: Design) -> None:
+    """[drive] against the follower: a screw drives a slide, a rotary axis an arm."""
+    drive = design.drive
+    if drive is None or drive.mode is not DriveMode.SERVO_FOLLOWER:
+        return
+    if design.follower.kind.oscillating and drive.screw_lead_mm is not None:
+        raise DesignError(
+            "drive.screw_lead_mm", "an oscillating follower is driven on its pivot (a rotary axis): no lead"
+        )
+    if not design.follower.kind.oscillating and drive.screw_lead_mm is None:
+        raise DesignError(
+            "drive.screw_lead_mm",
+            "is required for mode = 'servo-follower' on a translating follower (mm/rev)",
+        )
+
+
 def _check_design(design: Design) -> None:
     """The checks across fields, each naming the field to change."""
     _check_follower(design)
@@ -704,6 +790,7 @@ def _check_design(design: Design) -> None:
     _check_tolerances(design)
     _check_gcode(design)
     _check_fea(design)
+    _check_service(design)
 
 
 def _check_follower(design: Design) -> None:
@@ -1019,6 +1106,7 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
         specs[name] = cls(**_section(name, data.get(name, {})))
     if "fea" in data:  # present or not decides whether a build runs the FE check
         specs["fea"] = FeaSpec(**_section("fea", data["fea"]))
+    specs |= _service_tables(data)  # [life], [lubrication], [drive] (issue 35)
     for table in ("groove", "conjugate"):  # after their values, so a bad value names its own key
         if table in data and specs["cam"].style.value != table:
             raise DesignError(table, f"the [{table}] table applies to cam.style = '{table}' only")

@@ -14,6 +14,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+from camcad.dynamics.drive import DriveSpec
+from camcad.dynamics.film import LubricationSpec
+from camcad.dynamics.life import LifeSpec
 from camcad.dynamics.spec import DynamicsSetup, DynamicsSpec
 from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec
@@ -70,6 +73,9 @@ class Design:
     groove: GrooveSpec = field(default_factory=GrooveSpec)
     conjugate: ConjugateSpec = field(default_factory=ConjugateSpec)
     fea: FeaSpec | None = None  # the [fea] table: None when absent (the FE check then runs only on request)
+    life: LifeSpec | None = None  # [life], [lubrication], [drive] (issue 35): None when absent
+    lubrication: LubricationSpec | None = None
+    drive: DriveSpec | None = None
     source: str = ""
 
     def plate(self) -> Plate:

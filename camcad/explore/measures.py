@@ -13,7 +13,12 @@ name                      unit  figure
 ``contact_force``         N     peak contact force
 ``contact_force_min``     N     smallest contact force (follower jump below 0)
 ``curvature_radius``      mm    smallest convex profile radius
+``roller_life_h``         h     track roller's L10 life (``[life]``; issue 35)
+``min_film_ratio``        1     smallest film ratio λ (``[lubrication]``)
+``motor_rms_torque``      N·m   motor's RMS torque (``[drive]``)
 ========================  ====  =================================================
+
+The last three are empty (None) for a design without their table.
 
 A limit is ``name<=value`` or ``name>=value`` in those units (``--limit
 contact_stress<=800``).
@@ -73,6 +78,10 @@ _FIGURES: dict[str, Callable[[Analysis, Mapping[str, Any]], float | None]] = {
     "contact_force": lambda a, s: s["dynamics"].get("contact_force_max_N"),
     "contact_force_min": lambda a, s: s["dynamics"].get("contact_force_min_N"),
     "curvature_radius": lambda a, s: s["geometry"]["curvature_radius_min_mm"],
+    # issue 35: life, film and drive, when the design has their tables
+    "roller_life_h": lambda a, s: s.get("life", {}).get("roller_life_h"),
+    "min_film_ratio": lambda a, s: s.get("lubrication", {}).get("min_film_ratio"),
+    "motor_rms_torque": lambda a, s: s.get("drive", {}).get("motor_rms_torque_Nm"),
 }
 
 MEASURES: dict[str, Measure] = {
@@ -92,6 +101,11 @@ MEASURES: dict[str, Measure] = {
             column="curvature_radius_mm",
             text="smallest convex profile radius",
         ),
+        Measure(name="roller_life_h", unit="h", column="roller_life_h", text="track roller L10 life"),
+        Measure(
+            name="min_film_ratio", unit="1", column="min_film_ratio", text="smallest lubricant film ratio"
+        ),
+        Measure(name="motor_rms_torque", unit="N·m", column="motor_rms_torque_Nm", text="motor RMS torque"),
     )
 }
 """The objectives and limit quantities by name."""

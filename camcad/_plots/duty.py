@@ -1,0 +1,183 @@
+"""The figures of life, lubricant film and drive (issue 35), one per analysis the design asks for.
+
+- life: the roller's load over the turn with its ISO 281 equivalent load P,
+  and the track's load-stress factor K when a K–N line is given;
+- film: the minimum film thickness and the film ratio λ with its limit;
+- drive: the motor torque over the turn with the motor's peak and rated
+  torque, and the torque–speed plane with the motor's envelope.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from camcad._plots._base import COLORS, LIMIT, Plot, closed, figure, svg
+from camcad._plots.chart import HLine, Panel, Series, line_chart
+
+if TYPE_CHECKING:
+    from camcad.analysis import Analysis
+
+__all__ = ["drive_plots", "duty_plots", "film_plot", "life_plot"]
+
+
+def _bounds(analysis: Analysis) -> list[float]:
+    return [math.degrees(b) for b in analysis.cam.program.segment_bounds][1:]
+
+
+def _series(phi_deg: np.ndarray, values: object, color: str, label: str = "") -> Series:
+    x, y = closed(phi_deg, np.asarray(values, dtype=float))
+    return Series(x=x, y=y, color=color, label=label)
+
+
+def life_plot(analysis: Analysis) -> Plot | None:
+    """The roller's load over the turn against its equivalent load; the track's K when given."""
+    duty = analysis.duty
+    if duty is None or duty.life is None:
+        return None
+    phi = np.degrees(analysis.dynamics.phi)
+    panels = []
+    notes = []
+    if duty.roller is not None:
+        load = np.abs(np.asarray(analysis.dynamics.contact_force, dtype=float))
+        p = duty.roller.equivalent_load
+        panels.append(
+            Panel(
+                ylabel="roller load\n|F| [N]",
+                series=[_series(phi, load, COLORS[4], "roller load")],
+                lines=[HLine(y=p, color=COLORS[1], label=f"equivalent load P = {p:.1f} N (ISO 281)")],
+                legend=True,
+                height=140.0,
+            )
+        )
+        notes.append(
+            f"L10 = (C/P)^p = {duty.roller.l10_million_revolutions:.4g} million roller turns, "
+            f"{duty.roller.hours:.4g} h at {duty.roller.turns_per_cam_turn:.3f} roller turns a cam turn"
+        )
+    if duty.track is not None:
+        panels.append(
+            Panel(
+                ylabel="load-stress\nfactor K [MPa]",
+                series=[_series(phi, duty.track.factor, COLORS[6], "K = (F/L)(1/R₁ + 1/R₂)")],
+                legend=True,
+                height=140.0,
+            )
+        )
+        notes.append(
+            f"track life {duty.track.hours:.4g} h at the largest K ({duty.track.factor_max:.4g} MPa)"
+        )
+    if not panels:
+        sliding = float(np.max(duty.contact.sliding_speed))
+        return Plot(
+            key="life",
+            title="Life",
+            caption=f"The face slides on the cam (largest sliding speed {sliding:.1f} mm/s): rolling "
+            "life does not apply. Give [life] track_slope and track_intercept for the track's life.",
+        )
+    return Plot(
+        key="life",
+        title="Roller and track life",
+        caption="; ".join(notes) + ".",
+        svg=line_chart(panels, bounds_deg=_bounds(analysis), title="Roller and track life"),
+    )
+
+
+def film_plot(analysis: Analysis) -> Plot | None:
+    """Minimum film thickness and film ratio λ over the turn, λ's limit dashed."""
+    duty = analysis.duty
+    if duty is None or duty.film is None:
+        return None
+    film = duty.film
+    phi = np.degrees(film.phi)
+    shown_h = np.where(np.isfinite(film.thickness_um), film.thickness_um, np.nan)
+    shown_l = np.where(np.isfinite(film.ratio), film.ratio, np.nan)
+    top = float(np.nanmax(shown_l)) if np.isfinite(shown_l).any() else film.limit
+    panels = [
+        Panel(ylabel="film h_min\n[µm]", series=[_series(phi, shown_h, COLORS[0])], height=130.0),
+        Panel(
+            ylabel="film ratio λ",
+            series=[_series(phi, shown_l, COLORS[2], "λ = h_min/√(Rq₁² + Rq₂²)")],
+            lines=[HLine(y=film.limit, label=f"min_film_ratio {film.limit:g}")],
+            ylim=(0.0, max(top, film.limit) * 1.1),
+            legend=True,
+            height=130.0,
+        ),
+    ]
+    return Plot(
+        key="film",
+        title="Lubricant film",
+        caption=f"Dowson–Higginson minimum film thickness of the line contact; smallest λ "
+        f"{film.min_ratio:.3g} at φ = {math.degrees(film.angle):.1f}° "
+        f"(h_min {film.min_thickness_um:.3g} µm). "
+        "Gaps: no contact.",
+        svg=line_chart(panels, bounds_deg=_bounds(analysis), title="Lubricant film"),
+    )
+
+
+def drive_plots(analysis: Analysis) -> list[Plot]:
+    """Motor torque over the turn, and the torque–speed plane with the motor's envelope."""
+    duty = analysis.duty
+    if duty is None or duty.drive is None:
+        return []
+    drive, spec = duty.drive, analysis.design.drive
+    assert spec is not None
+    phi = np.degrees(drive.phi)
+    lines = [HLine(y=drive.rms_torque, color=COLORS[1], dash="2 3", label=f"RMS {drive.rms_torque:.3g} N·m")]
+    if spec.motor_peak_torque_Nm is not None:
+        lines += [
+            HLine(y=s * spec.motor_peak_torque_Nm, label="peak torque" if s > 0 else "") for s in (1, -1)
+        ]
+    if spec.motor_rated_torque_Nm is not None:
+        rated = spec.motor_rated_torque_Nm
+        lines += [HLine(y=s * rated, color="#e08e0b", label="rated torque" if s > 0 else "") for s in (1, -1)]
+    panel = Panel(
+        ylabel="motor torque\nT_m [N·m]",
+        series=[_series(phi, drive.motor_torque, COLORS[5], "motor torque")],
+        lines=lines,
+        legend=True,
+        height=170.0,
+    )
+    torque = Plot(
+        key="drive",
+        title="Motor torque",
+        caption=f"Torque at the motor ({drive.mode.value}): the load over i·η while the motor drives, "
+        f"times η/i while it is driven back; peak {drive.peak_torque:.3g} N·m, "
+        f"RMS {drive.rms_torque:.3g} N·m.",
+        svg=line_chart([panel], bounds_deg=_bounds(analysis), title="Motor torque"),
+    )
+    fig = figure()
+    ax = fig.add_subplot()
+    speed = np.asarray(drive.motor_speed_rpm, dtype=float)
+    step = max(1, speed.size // 360)  # about a point a degree: the figure stays small
+    keep = np.union1d(np.arange(0, speed.size, step), [int(np.argmax(np.abs(drive.motor_torque)))])
+    ax.plot(speed[keep], np.abs(drive.motor_torque[keep]), ".", color=COLORS[5], markersize=2.5,
+            label="|T_m| over the cycle")  # fmt: skip
+    ax.plot([float(np.max(speed))], [drive.rms_torque], "o", color=COLORS[1], label="RMS at top speed")
+    top_speed = spec.motor_max_rpm if spec.motor_max_rpm is not None else float(np.max(speed)) * 1.2
+    if spec.motor_peak_torque_Nm is not None:
+        ax.plot([0.0, top_speed], [spec.motor_peak_torque_Nm] * 2, **LIMIT, label="peak torque")
+    if spec.motor_rated_torque_Nm is not None:
+        ax.plot([0.0, top_speed], [spec.motor_rated_torque_Nm] * 2, color="#e08e0b", label="rated torque")
+    if spec.motor_max_rpm is not None:
+        ax.axvline(spec.motor_max_rpm, **LIMIT)
+    ax.set_xlim(0.0, max(top_speed, float(np.max(speed))) * 1.05)
+    ax.set_ylim(0.0, None)
+    ax.set_xlabel("motor speed [rpm]")
+    ax.set_ylabel("|motor torque| [N·m]")
+    ax.legend(loc="upper right", fontsize=8)
+    envelope = Plot(
+        key="drive-envelope",
+        title="Torque and speed",
+        caption="The motor's operating points against its envelope: peak torque (dashed), rated "
+        "torque for the RMS, and its highest speed.",
+        svg=svg(fig),
+    )
+    return [torque, envelope]
+
+
+def duty_plots(analysis: Analysis) -> list[Plot]:
+    """Every figure of life, film and drive the analysis has."""
+    out = [p for p in (life_plot(analysis), film_plot(analysis)) if p is not None]
+    return out + drive_plots(analysis)
