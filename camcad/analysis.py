@@ -120,6 +120,11 @@ class Analysis:
 def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
     """True peaks of |v|, |a|, |j| with their angles (one-sided at joints), the lift and the joint report.
 
+    ``lift_*`` is the nominal lift (the largest total the program states);
+    ``stroke_*`` the true travel, max − min of s over the turn (its ends in
+    ``travel_max_*`` and ``travel_min_*`` with their angles), which is larger
+    where a segment overshoots.
+
     Where the velocity jumps (``velocity_jumps_deg``) the acceleration is an
     impulse: the peaks of |a| and |j| are infinite and reported as ``None``.
     """
@@ -136,6 +141,21 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
 
     values = np.abs(np.vstack((motion.v, motion.a, motion.j)))
     peaks = extremes_rows(rows, motion.phi, joints, ("max", "max", "max"), values=values)
+
+    def travel(p: FloatArray, side: Side) -> FloatArray:
+        s = cam.motion(p, side=side).s
+        return np.vstack((s, s))
+
+    # the true stroke: the follower's travel max − min over the turn, refined on the exact motion (a
+    # segment that overshoots, as a return out of a constant-velocity rise does, can exceed the lift)
+    top, bottom = extremes_rows(
+        travel, motion.phi, joints, ("max", "min"), values=np.vstack((motion.s, motion.s))
+    )
+    out[f"stroke_{u}"] = top.value - bottom.value
+    out[f"travel_max_{u}"] = top.value
+    out["travel_max_angle_deg"] = top.angle_deg
+    out[f"travel_min_{u}"] = bottom.value
+    out["travel_min_angle_deg"] = bottom.angle_deg
     for (key, unit), peak in zip(
         (("v", f"{u}_per_rad"), ("a", f"{u}_per_rad2"), ("j", f"{u}_per_rad3")), peaks, strict=True
     ):
@@ -155,7 +175,7 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
             f"da_{u}_per_rad2": j.da,
             f"dj_{u}_per_rad3": j.dj,
             "continuity": j.continuity,
-            "text": j.describe(),
+            "text": j.describe(u),
         }
         for j in cam.program.joints()
     ]
