@@ -190,7 +190,10 @@ class DynamicsResult:
             }
         if self.crossovers:
             out["crossover_angles_deg"] = [_deg(p) for p in self.crossovers]
-            out["impact_speed_max_mm_per_s"] = max(self.impact_speeds, default=None)
+            # a massless follower has no free flight (NaN): no figure
+            out["impact_speed_max_mm_per_s"] = max(
+                (v for v in self.impact_speeds if math.isfinite(v)), default=None
+            )
         return out
 
     @property
