@@ -105,6 +105,10 @@ class Analysis:
             "dynamics": self.dynamics.summary(),
             **self.positive.summary(),
         }
+        if "groove" in out:  # the pressure angle is the same on both flanks; say which one drives there
+            out["groove"]["pressure_angle_max_flank"] = _flank_at(
+                self.dynamics, self.geometry.pressure_angle_max.phi
+            )
         if self.fit is not None:
             out["fit"] = self.fit.summary()
         if self.gcode is not None:
@@ -115,6 +119,15 @@ class Analysis:
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]
         return out
+
+
+def _flank_at(dynamics: DynamicsResult, phi: float) -> str | None:
+    """The groove flank that drives at cam angle φ [rad]: the sign of the nearest sample's contact force."""
+    d = np.angle(np.exp(1j * (np.asarray(dynamics.phi) - phi)))  # wrapped distance [rad]
+    force = float(dynamics.contact_force[int(np.argmin(np.abs(d)))])
+    if force == 0.0:
+        return None  # a rest: neither flank drives
+    return "inner" if force > 0.0 else "outer"
 
 
 def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:

@@ -124,7 +124,12 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
             "max pressure angle",
             _fmt(geo["pressure_angle_max_deg"], "°", 2)
             + _at(geo, "pressure_angle_max")
-            + f" (limit {limit:g}°)",
+            + f" (limit {limit:g}°"
+            + (
+                f"; {flank} flank drives)"
+                if (flank := summary.get("groove", {}).get("pressure_angle_max_flank"))
+                else ")"
+            ),
         ),
         (
             "min curvature radius",

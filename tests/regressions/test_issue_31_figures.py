@@ -91,6 +91,16 @@ def test_groove_outer_flank_stress_where_it_drives() -> None:
     assert "on the outer flank" in cards and f"{dyn['flanks']['outer']['contact_force_max_N']:.3f} N" in cards
 
 
+def test_groove_pressure_angle_names_the_flank_that_drives() -> None:
+    # no spring: the arm's moment I·ψ″·ω² has the sign of ψ″; positive: the inner flank pushes
+    design, _ = _sample("groove_rocker.toml")
+    result = analyse(design, fit=False, toolpath=False)
+    summary = result.summary()
+    at = math.radians(summary["geometry"]["pressure_angle_max_angle_deg"])
+    a = float(result.cam.motion(np.array([at])).a[0])
+    assert summary["groove"]["pressure_angle_max_flank"] == ("inner" if a > 0.0 else "outer")
+
+
 def test_groove_check_names_the_flank(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     text = (ROOT / "samples" / "groove_rocker.toml").read_text()
     text = text.replace(
