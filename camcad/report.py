@@ -646,9 +646,18 @@ def compare_table(analyses: Sequence[Analysis]) -> list[list[str]]:
     """
     keys = [_key_numbers(a, a.summary()) for a in analyses]
     table = [["quantity", *_names(analyses)]]
+    unit = _lift_unit_text(analyses)  # an arm's lift, |v| and |a| are in degrees of swing
     for text, key, spec in _COMPARE_ROWS:
+        if key in ("lift", "v", "a"):
+            text = text.replace("[mm", f"[{unit}")
         table.append([text, *(_num(k[key], spec) for k in keys)])
     return table
+
+
+def _lift_unit_text(analyses: Sequence[Analysis]) -> str:
+    """The lift's unit of several designs as shown: ``mm`` (slides), ``°`` (arms) or ``mm or °``."""
+    units = {"°" if a.cam.follower.kind.oscillating else "mm" for a in analyses}
+    return units.pop() if len(units) == 1 else "mm or °"
 
 
 def _letter(i: int) -> str:

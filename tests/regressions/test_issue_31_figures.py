@@ -247,3 +247,18 @@ def test_a_massless_follower_has_no_impact_figure() -> None:
     dyn = result.summary()["dynamics"]
     assert len(dyn["crossover_angles_deg"]) == 2
     assert dyn["impact_speed_max_mm_per_s"] is None
+
+
+def test_comparing_arms_labels_degrees() -> None:
+    from camcad._plots.compare import compare_plots
+    from camcad.report import compare_table
+
+    arms = [
+        analyse(_sample(n)[0], fit=False, toolpath=False) for n in ("groove_rocker.toml", "rocker_flat.toml")
+    ]
+    rows = {r[0] for r in compare_table(arms)}
+    assert {"lift [°]", "max |v| [°/rad]", "max |a| [°/rad²]"} <= rows
+    assert not [r for r in rows if r.startswith(("lift", "max |v|", "max |a|")) and "mm" in r]
+    plots = compare_plots(arms, ["A", "B"])
+    labels = " ".join(str(p.svg, "utf-8") for p in plots if p.key in ("compare-s", "compare-v"))
+    assert "[°/rad]" in labels and "[mm/rad]" not in labels
