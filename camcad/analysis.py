@@ -109,6 +109,10 @@ class Analysis:
             "dynamics": self.dynamics.summary(),
             **self.positive.summary(),
         }
+        if "groove" in out:  # the pressure angle is the same on both flanks; say which one drives there
+            out["groove"]["pressure_angle_max_flank"] = _flank_at(
+                self.dynamics, self.geometry.pressure_angle_max.phi
+            )
         if self.fit is not None:
             out["fit"] = self.fit.summary()
         if self.gcode is not None:
@@ -123,8 +127,22 @@ class Analysis:
         return out
 
 
+def _flank_at(dynamics: DynamicsResult, phi: float) -> str | None:
+    """The groove flank that drives at cam angle φ [rad]: the sign of the nearest sample's contact force."""
+    d = np.angle(np.exp(1j * (np.asarray(dynamics.phi) - phi)))  # wrapped distance [rad]
+    force = float(dynamics.contact_force[int(np.argmin(np.abs(d)))])
+    if force == 0.0:
+        return None  # a rest: neither flank drives
+    return "inner" if force > 0.0 else "outer"
+
+
 def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
     """True peaks of |v|, |a|, |j| with their angles (one-sided at joints), the lift and the joint report.
+
+    ``lift_*`` is the nominal lift (the largest total the program states);
+    ``stroke_*`` the true travel, max − min of s over the turn (its ends in
+    ``travel_max_*`` and ``travel_min_*`` with their angles), which is larger
+    where a segment overshoots.
 
     Where the velocity jumps (``velocity_jumps_deg``) the acceleration is an
     impulse: the peaks of |a| and |j| are infinite and reported as ``None``.
@@ -142,6 +160,21 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
 
     values = np.abs(np.vstack((motion.v, motion.a, motion.j)))
     peaks = extremes_rows(rows, motion.phi, joints, ("max", "max", "max"), values=values)
+
+    def travel(p: FloatArray, side: Side) -> FloatArray:
+        s = cam.motion(p, side=side).s
+        return np.vstack((s, s))
+
+    # the true stroke: the follower's travel max − min over the turn, refined on the exact motion (a
+    # segment that overshoots, as a return out of a constant-velocity rise does, can exceed the lift)
+    top, bottom = extremes_rows(
+        travel, motion.phi, joints, ("max", "min"), values=np.vstack((motion.s, motion.s))
+    )
+    out[f"stroke_{u}"] = top.value - bottom.value
+    out[f"travel_max_{u}"] = top.value
+    out["travel_max_angle_deg"] = top.angle_deg
+    out[f"travel_min_{u}"] = bottom.value
+    out["travel_min_angle_deg"] = bottom.angle_deg
     for (key, unit), peak in zip(
         (("v", f"{u}_per_rad"), ("a", f"{u}_per_rad2"), ("j", f"{u}_per_rad3")), peaks, strict=True
     ):
@@ -161,7 +194,7 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
             f"da_{u}_per_rad2": j.da,
             f"dj_{u}_per_rad3": j.dj,
             "continuity": j.continuity,
-            "text": j.describe(),
+            "text": j.describe(u),
         }
         for j in cam.program.joints()
     ]

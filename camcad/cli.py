@@ -102,21 +102,34 @@ def _at(section: dict[str, Any], key: str) -> str:
     return f" at {angle:.1f}°" + (f" (just {side.replace(' joint', ' the joint')})" if side else "")
 
 
+def _lift_row(motion: dict[str, Any]) -> tuple[str, str]:
+    """The nominal lift (or swing), with the true stroke beside it where the travel exceeds it."""
+    name, u, shown = ("lift", "mm", " mm") if "lift_mm" in motion else ("arm swing", "deg", "°")
+    text = _fmt(motion[f"lift_{u}"], shown)
+    stroke = motion.get(f"stroke_{u}")
+    if stroke is not None and round(stroke, 3) != round(motion[f"lift_{u}"], 3):
+        low, high = (round(motion[f"travel_{e}_{u}"], 3) + 0.0 for e in ("min", "max"))  # no "-0.000"
+        top = f"{_fmt(low, shown)} to {_fmt(high, shown)}"
+        text += f" (true stroke {_fmt(stroke, shown)}: {top} at {motion['travel_max_angle_deg']:.1f}°)"
+    return name, text
+
+
 def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
     geo, dyn = summary["geometry"], summary["dynamics"]
     fit = summary.get("fit") or {}
     limit = math.degrees(design.cam.max_pressure_angle)
     return [
-        (
-            ("lift", _fmt(summary["motion"]["lift_mm"], " mm"))
-            if "lift_mm" in summary["motion"]
-            else ("arm swing", _fmt(summary["motion"]["lift_deg"], "°"))
-        ),
+        _lift_row(summary["motion"]),
         (
             "max pressure angle",
             _fmt(geo["pressure_angle_max_deg"], "°", 2)
             + _at(geo, "pressure_angle_max")
-            + f" (limit {limit:g}°)",
+            + f" (limit {limit:g}°"
+            + (
+                f"; {flank} flank drives)"
+                if (flank := summary.get("groove", {}).get("pressure_angle_max_flank"))
+                else ")"
+            ),
         ),
         (
             "min curvature radius",
@@ -129,7 +142,9 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
         ("min contact force", _fmt(dyn.get("contact_force_min_N"), " N", 2) + _at(dyn, "contact_force_min")),
         (
             "max contact stress",
-            _fmt(dyn.get("hertz_stress_max_MPa"), " MPa", 1) + _at(dyn, "hertz_stress_max"),
+            _fmt(dyn.get("hertz_stress_max_MPa"), " MPa", 1)
+            + _at(dyn, "hertz_stress_max")
+            + (f" ({dyn['hertz_stress_max_flank']} flank)" if dyn.get("hertz_stress_max_flank") else ""),
         ),
         (
             "follower jump",
@@ -191,6 +206,17 @@ def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
             ("largest cutter radius", _fmt(groove["tool_radius_max_mm"], " mm")),
             ("outer flank reach", _fmt(groove["outer_flank_reach_mm"], " mm")),
         ]
+        for name, flank in summary["dynamics"].get("flanks", {}).items():  # where each flank drives
+            load = "does not drive"
+            if flank["contact_force_max_N"] is not None:
+                load = (
+                    _fmt(flank["contact_force_max_N"], " N", 2)
+                    + _at(flank, "contact_force_max")
+                    + ", stress "
+                    + _fmt(flank["hertz_stress_max_MPa"], " MPa", 1)
+                    + _at(flank, "hertz_stress_max")
+                )
+            rows.append((f"{name} flank max load", load))
     if second is not None:
         geo = second["geometry"]
         rows += [
@@ -201,6 +227,17 @@ def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
             (
                 "2nd plate min curvature",
                 _fmt(geo["curvature_radius_min_mm"], " mm") + _at(geo, "curvature_radius_min"),
+            ),
+        ]
+        dyn2 = second["dynamics"]  # the second plate's own roller and contact
+        rows += [
+            (
+                "2nd plate max force",
+                _fmt(dyn2.get("contact_force_max_N"), " N", 2) + _at(dyn2, "contact_force_max"),
+            ),
+            (
+                "2nd plate max stress",
+                _fmt(dyn2.get("hertz_stress_max_MPa"), " MPa", 1) + _at(dyn2, "hertz_stress_max"),
             ),
         ]
     if groove is not None or second is not None:

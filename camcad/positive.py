@@ -101,7 +101,8 @@ def analyse_positive_drive(design: Design, cam: Cam) -> PositiveDrive:
         partner.motion(geometry.phi),
         pressure_angle=geometry.pressure_angle,
         profile_rho=geometry.profile.rho,
-        setup=replace(design.dynamics_setup(), drive_sign=-1.0),
+        # the second plate's own roller: its radius sets the Hertz contact (Johnson 1985, §4.3)
+        setup=replace(design.dynamics_setup(), drive_sign=-1.0, roller_radius=partner.roller_radius),
         cam=partner,
     )
     return PositiveDrive(partner=partner, partner_geometry=geometry, partner_dynamics=dynamics)

@@ -291,6 +291,7 @@ def _key_numbers(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, An
     unit = analysis.cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     return {
         "lift": analysis.cam.program.lift,
+        "stroke": motion.get(f"stroke_{unit}"),  # the true travel, max − min of s
         "v": motion.get(f"v_max_abs_{unit}_per_rad", _peak(np.abs(analysis.motion.v))),
         "a": motion.get(f"a_max_abs_{unit}_per_rad2", _peak(np.abs(analysis.motion.a))),
         "alpha": geo.get(
@@ -305,6 +306,9 @@ def _key_numbers(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, An
         "force_max": dyn.get("contact_force_max_N", _peak(d.contact_force)),
         "force_min": dyn.get("contact_force_min_N", _peak(d.contact_force, np.min)),
         "stress": dyn.get("hertz_stress_max_MPa", _peak(d.hertz_stress)),
+        "stress_flank": dyn.get("hertz_stress_max_flank"),  # a groove: the flank that carries it
+        "flanks": dyn.get("flanks"),
+        "second_plate": summary.get("second_plate", {}).get("dynamics"),
         "stress_allowable": analysis.design.dynamics.allowable_stress,
         "control_points": None if fit is None else fit.get("control_points"),
         "fit_error": None if fit is None else fit.get("max_error_mm"),
@@ -335,6 +339,8 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
         if k["rho_at"] is not None
         else "profile has no convex part"
     )
+    if k["rho"] is not None and k["rho"] < 0.0:  # the signed extreme: the profile loops or has a cusp
+        rho_note = f"< 0: the profile {'loops' if cam.is_roller else 'has a cusp'} at φ = {k['rho_at']:.1f}°"
     stress_over = (
         k["stress_allowable"] is not None and k["stress"] is not None and k["stress"] > k["stress_allowable"]
     )
@@ -343,7 +349,32 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
         if k["stress_allowable"] is not None
         else "no allowable set"
     )
-    force_over = k["force_min"] is not None and k["force_min"] < analysis.design.dynamics.min_contact_force
+    if k["stress_flank"] is not None:
+        stress_note += f"; on the {k['stress_flank']} flank"
+    second = k["second_plate"]
+    if second is not None:  # a conjugate pair: the second plate with its own roller
+        stress_note += f"; 2nd plate {_num(second.get('hertz_stress_max_MPa'), '.2f')} MPa"
+        over2 = (
+            k["stress_allowable"] is not None
+            and (second.get("hertz_stress_max_MPa") or 0.0) > k["stress_allowable"]
+        )
+        stress_over = stress_over or over2
+    # a positively driven follower's force changes sign at crossovers: that is no loss of contact
+    force_over = (
+        not analysis.dynamics.positive_drive
+        and k["force_min"] is not None
+        and k["force_min"] < analysis.design.dynamics.min_contact_force
+    )
+    force_value, force_note = f"{_num(k['force_max'], '.3f')} N", f"min {_num(k['force_min'], '.3f')} N"
+    if k["flanks"] is not None:  # a groove: the largest load on the flank that drives
+        loads = {n: f["contact_force_max_N"] or 0.0 for n, f in k["flanks"].items()}
+        worst = max(loads, key=lambda n: loads[n])
+        force_value = f"{_num(loads[worst], '.3f')} N"
+        force_note = f"{worst} flank; " + ", ".join(
+            f"{n} flank max {_num(v, '.3f')} N" for n, v in loads.items()
+        )
+    elif second is not None:
+        force_note += f"; 2nd plate max {_num(second.get('contact_force_max_N'), '.3f')} N"
     if k["control_points"] is None:
         fit_card = _card("NURBS fit", "not run")
     else:
@@ -359,22 +390,21 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
         gcode_card = _card(
             "G-code", f"{gcode.get('blocks')} blocks", f"{gcode.get('arcs')} arcs, about {minutes:.1f} min"
         )
+    shown = "°" if cam.follower.kind.oscillating else " mm"
+    stroke_note = ""
+    if k["stroke"] is not None and round(k["stroke"], 3) != round(k["lift"], 3):  # a segment overshoots
+        stroke_note = f"nominal; true stroke {k['stroke']:.3f}{shown}"
     cards = [
-        _card("Arm swing", f"{k['lift']:.3f}°")
-        if cam.follower.kind.oscillating
-        else _card("Lift", f"{k['lift']:.3f} mm"),
+        _card(
+            "Arm swing" if cam.follower.kind.oscillating else "Lift", f"{k['lift']:.3f}{shown}", stroke_note
+        ),
         _card("Base radius", f"{cam.base_radius:.3f} mm", follower),
         _card("Max pressure angle", f"{k['alpha']:.2f}°", alpha_note, over=alpha_over),
         _card("Min curvature radius", f"{_num(k['rho'], '.3f')} mm", rho_note),
         _card(
             "Max torque", f"{_num(k['torque_max'], '.2f')} N·mm", f"min {_num(k['torque_min'], '.2f')} N·mm"
         ),
-        _card(
-            "Max contact force",
-            f"{_num(k['force_max'], '.3f')} N",
-            f"min {_num(k['force_min'], '.3f')} N",
-            over=force_over,
-        ),
+        _card("Max contact force", force_value, force_note, over=force_over),
         _card("Max Hertz stress", f"{_num(k['stress'], '.2f')} MPa", stress_note, over=stress_over),
         fit_card,
         *([gcode_card] if gcode is not None else []),
@@ -632,9 +662,18 @@ def compare_table(analyses: Sequence[Analysis]) -> list[list[str]]:
     """
     keys = [_key_numbers(a, a.summary()) for a in analyses]
     table = [["quantity", *_names(analyses)]]
+    unit = _lift_unit_text(analyses)  # an arm's lift, |v| and |a| are in degrees of swing
     for text, key, spec in _COMPARE_ROWS:
+        if key in ("lift", "v", "a"):
+            text = text.replace("[mm", f"[{unit}")
         table.append([text, *(_num(k[key], spec) for k in keys)])
     return table
+
+
+def _lift_unit_text(analyses: Sequence[Analysis]) -> str:
+    """The lift's unit of several designs as shown: ``mm`` (slides), ``°`` (arms) or ``mm or °``."""
+    units = {"°" if a.cam.follower.kind.oscillating else "mm" for a in analyses}
+    return units.pop() if len(units) == 1 else "mm or °"
 
 
 def _letter(i: int) -> str:

@@ -23,6 +23,7 @@ from camcad.fea.spec import FeaSpec
 from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import follower_from_spec
 from camcad.geometry.followers import OscillatingFlat, OscillatingRoller
+from camcad.geometry.groove import roller_flank_offsets
 from camcad.geometry.plate import BoreOutline, Plate
 from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
 from camcad.motion.segments import SegmentSpec
@@ -102,6 +103,9 @@ class Design:
             arm_angle=_arm_direction(fol, cam.base_radius),
             positive_drive=cam.style is not CamStyle.PLATE,
             clearance=self.groove.clearance if cam.style is CamStyle.GROOVE else 0.0,
+            flank_offsets=roller_flank_offsets(fol.roller_radius, self.groove.clearance)
+            if cam.style is CamStyle.GROOVE
+            else None,
         )
 
     def with_base_radius(self, base_radius: float) -> Design:

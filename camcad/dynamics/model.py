@@ -19,8 +19,9 @@ from camcad.angles import TWO_PI
 from camcad.dynamics.arm import ArmLoad, arm_speed
 from camcad.dynamics.contact import contact_curvature, effective_modulus, hertz_stress
 from camcad.dynamics.energy import FollowerLoad, contact_force, input_torque
+from camcad.dynamics.flight import impact_speed
 from camcad.dynamics.jump import covering_arc, loss_runs, preload_need, speed_bounds, speed_window
-from camcad.dynamics.results import DynamicsResult
+from camcad.dynamics.results import FLANK_WORDS, DynamicsResult
 from camcad.dynamics.spec import DynamicsModel, DynamicsSetup, DynamicsSpec
 from camcad.dynamics.spring import spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, tappet_forces
@@ -37,6 +38,8 @@ __all__ = ["analyse_dynamics"]
 _RAD_S_TO_RPM = 60.0 / (2.0 * math.pi)
 # the extremes analyse_dynamics reports, one per row of its quantity
 _KINDS: tuple[Kind, ...] = ("min", "max", "min", "max", "max", "max", "max", "min", "max")
+# a groove's further extremes: the load and the stress on each flank where it drives (inner, outer)
+_FLANK_KINDS: tuple[Kind, ...] = ("max", "max", "max", "max")
 # Warn when a guide force changes side and its misdirected friction exceeds this share of N1.
 _GUIDE_FLIP_RTOL = 0.01
 
@@ -129,6 +132,14 @@ def _preload(setup: DynamicsSetup) -> float:
     return _arm_load(setup).preload
 
 
+def _load(setup: DynamicsSetup) -> FollowerLoad | ArmLoad:
+    """What the follower carries: its inertia, spring and weight (about the pivot on an arm)."""
+    dyn = setup.spec
+    if setup.arm_angle is None:
+        return FollowerLoad(mass=dyn.follower_mass, spring=spring_from_spec(dyn), gravity=dyn.gravity)
+    return _arm_load(setup)
+
+
 def _model(setup: DynamicsSetup) -> _Model:
     """The design's dynamic model as a pointwise function of (motion, α, profile ρ, lever r).
 
@@ -137,12 +148,7 @@ def _model(setup: DynamicsSetup) -> _Model:
     force over c = cos α (slide) or c = r·cos α (arm, :mod:`camcad.dynamics.arm`).
     """
     dyn = setup.spec
-    spring = spring_from_spec(dyn)
-    load: FollowerLoad | ArmLoad = (
-        FollowerLoad(mass=dyn.follower_mass, spring=spring, gravity=dyn.gravity)
-        if setup.arm_angle is None
-        else _arm_load(setup)
-    )
+    load = _load(setup)
     omega = setup.omega
     roller = setup.roller_radius
     modulus = effective_modulus(
@@ -152,6 +158,7 @@ def _model(setup: DynamicsSetup) -> _Model:
         poisson_2=dyn.follower_poisson,
     )
     length = setup.contact_length
+    flanks = setup.flank_offsets
     tappet = None
     if dyn.model is DynamicsModel.GUIDED_TAPPET:
         tappet = GuidedTappet(
@@ -182,9 +189,17 @@ def _model(setup: DynamicsSetup) -> _Model:
             force = contact_force(axial, alpha)
             torque = input_torque(axial, setup.drive_sign * motion.v, friction_torque=dyn.friction_torque)
             ratio = np.cos(alpha)
-        stress = hertz_stress(
-            force, curvature=contact_curvature(rho, roller_radius=roller), length=length, modulus=modulus
-        )
+        if flanks is None:
+            curvature = contact_curvature(rho, roller_radius=roller)
+        else:  # a groove: the flank that drives, the inner one where F > 0, the outer one where F < 0
+            inner = contact_curvature(rho + flanks[0], roller_radius=roller)  # roller outside it
+            # the roller inside the outer flank: its radius seen from the roller is −ρ_outer, so
+            # 1/R* = 1/r_f − 1/ρ_outer (Johnson 1985, §4.3, a concave surface's radius negative)
+            outer = contact_curvature(-(rho + flanks[1]), roller_radius=roller)
+            curvature = np.where(np.asarray(force) >= 0.0, inner, outer)
+            force = np.asarray(force, dtype=float)
+        pressing = force if flanks is None else np.abs(force)
+        stress = hertz_stress(pressing, curvature=curvature, length=length, modulus=modulus)
         return _Pointwise(
             force=np.asarray(force, dtype=float),
             torque=np.asarray(torque, dtype=float),
@@ -264,8 +279,16 @@ def analyse_dynamics(
     margin = dyn.min_contact_force
     spring_preload = _preload(setup)
 
-    found = _extremes(model, sampled, phi, cam, margin=margin, omega=omega, preload=spring_preload)
-    force_min, force_max, torque_min, torque_max, stress_max, need, flat_need, upper, lower = found
+    grooved = setup.flank_offsets is not None
+    found = _extremes(
+        model, sampled, phi, cam, margin=margin, omega=omega, preload=spring_preload, flanks=grooved
+    )
+    force_min, force_max, torque_min, torque_max, stress_max, need, flat_need, upper, lower = found[:9]
+    flank_force = flank_stress = None
+    stress_flank = None
+    if grooved:
+        flank_force, flank_stress = (found[9], found[10]), (found[11], found[12])
+        stress_flank = FLANK_WORDS[0 if flank_stress[0].value >= flank_stress[1].value else 1]
     preload = max(0.0, need.value)
     if setup.arm_angle is not None and dyn.spring_arm is not None:
         preload /= dyn.spring_arm  # the linear spring's force at its lever [N]
@@ -294,6 +317,7 @@ def analyse_dynamics(
         speeds=speeds,
         force_min=force_min,
         stress_max=stress_max,
+        stress_flank=stress_flank,
     )
     warnings = [f.message for f in findings] + warnings
     torque = np.asarray(sampled.torque, dtype=float)
@@ -323,6 +347,9 @@ def analyse_dynamics(
         hertz_stress_max=stress_max,
         crossovers=crossovers,
         impact_speeds=impacts,
+        positive_drive=setup.positive_drive,
+        flank_force_max=flank_force,
+        flank_stress_max=flank_stress,
     )
 
 
@@ -337,12 +364,11 @@ def _crossovers(
     stretch has opposite signs. A change between neighbouring samples is
     refined by Brent's method on the exact model (when the cam is given); one
     across a rest is placed where the rest ends, at the joint where the new
-    flank starts to drive. At a crossover the follower floats across the
-    clearance c while the force that would hold it grows at the rate of the
-    jerk: the gap closes as J·t³/6, so the roller meets the other flank after
-    t = (6c/J)^(1/3) at the relative speed J·t²/2 (Norton 2009, §8.11
-    "crossover shock"; J = |d³s/dt³| [mm/s³] on a slide, |d³ψ/dt³|·r on an
-    arm, r the distance from the pivot to the roller centre).
+    flank starts to drive. From a crossover the follower flies free across
+    the clearance c under its own inertia, spring and weight until it meets a
+    flank; the impact speed is its normal approach speed then
+    (:func:`camcad.dynamics.flight.impact_speed`, Norton 2009, §8.11
+    "crossover shock").
     """
     scale = float(np.max(np.abs(force), initial=0.0))
     live = np.flatnonzero(np.abs(force) > 1e-9 * scale)
@@ -374,20 +400,18 @@ def _crossovers(
         root %= TWO_PI
         found.append(root)
         if cam is not None and setup.clearance > 0.0:
-            speeds.append(_impact_speed(cam, root, setup))
+            leaving = 1.0 if sign[k] else -1.0  # the flank it leaves drove it forwards (F > 0) or back
+            speeds.append(
+                impact_speed(
+                    cam,
+                    root,
+                    load=_load(setup),
+                    omega=setup.omega,
+                    clearance=setup.clearance,
+                    leaving=leaving,
+                )
+            )
     return tuple(found), tuple(speeds)
-
-
-def _impact_speed(cam: Cam, phi: float, setup: DynamicsSetup) -> float:
-    """Speed [mm/s] at which the roller meets the other flank after a crossover at φ (Norton §8.11)."""
-    st = cam.state(np.array([phi]), side="right")
-    jerk = abs(float(st.motion.j[0])) * setup.omega**3  # mm/s³, or degrees/s³ of swing on an arm
-    if st.lever is not None:
-        jerk *= math.pi / 180.0 * float(st.lever[0])
-    if jerk <= 0.0:
-        return 0.0
-    t = (6.0 * setup.clearance / jerk) ** (1.0 / 3.0)
-    return 0.5 * jerk * t * t
 
 
 def _extremes(
@@ -399,15 +423,25 @@ def _extremes(
     margin: float,
     omega: float,
     preload: float,
+    flanks: bool = False,
 ) -> tuple[Extreme, ...]:
-    """The true extremes of every reported quantity (``_KINDS``), or the samples' without a cam."""
+    """The true extremes of every reported quantity (``_KINDS``, then a groove's ``_FLANK_KINDS``).
+
+    Without a cam, the samples' extremes.
+    """
+    kinds = _KINDS + _FLANK_KINDS if flanks else _KINDS
 
     def rows(r: _Pointwise) -> FloatArray:
-        return _reported(r, margin=margin, omega=omega, preload=preload)
+        out = _reported(r, margin=margin, omega=omega, preload=preload)
+        if flanks:  # load and stress of the flank that drives: the inner one where F > 0
+            inner = r.force > 0.0
+            on_inner, on_outer = np.where(inner, r.stress, 0.0), np.where(inner, 0.0, r.stress)
+            out = np.vstack((out, np.maximum(r.force, 0.0), np.maximum(-r.force, 0.0), on_inner, on_outer))
+        return out
 
     values = rows(sampled)
     if cam is None:
-        return tuple(_sampled_extreme(phi, row, kind) for row, kind in zip(values, _KINDS, strict=True))
+        return tuple(_sampled_extreme(phi, row, kind) for row, kind in zip(values, kinds, strict=True))
     exact = cam
 
     def quantity(p: FloatArray, side: Side) -> FloatArray:
@@ -415,7 +449,7 @@ def _extremes(
         return rows(model(st.motion, st.pressure_angle, st.profile.rho, st.lever))
 
     joints = [bp.phi for bp in cam.program.breakpoints]
-    return extremes_rows(quantity, phi, joints, _KINDS, values=values)
+    return extremes_rows(quantity, phi, joints, kinds, values=values)
 
 
 def _findings(
@@ -429,6 +463,7 @@ def _findings(
     speeds: tuple[float, float] | None,
     force_min: Extreme,
     stress_max: Extreme,
+    stress_flank: str | None = None,
 ) -> list[Finding]:
     """The soft limits the dynamics breaks: follower jump (with its remedies) and Hertz stress."""
     margin = dyn.min_contact_force
@@ -447,8 +482,9 @@ def _findings(
         field = "dynamics.spring_preload_torsional" if torsional else "dynamics.spring_preload"
         findings.append(_limit("jump", field, message, force_min, margin, "N"))
     if dyn.allowable_stress is not None and stress_max.value > dyn.allowable_stress:
+        on = "" if stress_flank is None else f" on the {stress_flank} flank"
         message = (
-            f"Hertz contact stress reaches {stress_max.value:.1f} MPa {stress_max.where()}, above the "
+            f"Hertz contact stress reaches {stress_max.value:.1f} MPa {stress_max.where()}{on}, above the "
             f"allowable {dyn.allowable_stress:g} MPa: widen the contact, enlarge the roller or the "
             "base circle, or lower the spring load"
         )

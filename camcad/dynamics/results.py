@@ -19,10 +19,25 @@ from camcad.dynamics.spec import DynamicsModel
 from camcad.extremes import SIDE_WORDS, Extreme
 from camcad.findings import Finding
 
-__all__ = ["CSV_HEADER", "DynamicsResult"]
+__all__ = ["CSV_HEADER", "FLANK_WORDS", "DynamicsResult"]
 
 CSV_HEADER = ("angle_deg", "contact_force_N", "torque_Nmm", "hertz_stress_MPa")
 """Column names of ``dynamics.csv``."""
+
+
+FLANK_WORDS = ("inner", "outer")
+"""A groove's flanks: the inner drives where the contact force is positive, the outer where negative."""
+
+
+def _flank(force: Extreme, stress: Extreme) -> dict[str, Any]:
+    """One flank's figures where it drives: its largest load and Hertz stress (None if it never drives)."""
+    drives = force.value > 0.0
+    out: dict[str, Any] = {}
+    for key, unit, ext in (("contact_force_max", "N", force), ("hertz_stress_max", "MPa", stress)):
+        out[f"{key}_{unit}"] = ext.value if drives else None
+        out[f"{key}_angle_deg"] = round(ext.angle_deg, 6) if drives else None
+        out[f"{key}_side"] = SIDE_WORDS[ext.side] if drives and ext.side is not None else None
+    return out
 
 
 def _deg(phi: float) -> float:
@@ -104,6 +119,10 @@ class DynamicsResult:
     hertz_stress_max: Extreme | None = None
     crossovers: tuple[float, ...] = ()  # rad, positive drive: where the driving flank (or roller) changes
     impact_speeds: tuple[float, ...] = ()  # mm/s across the groove's clearance, one per crossover
+    positive_drive: bool = False  # a groove or conjugate pair: no spring holds it on, no jump check
+    # a groove's inner and outer flank: the largest load [N] and Hertz stress [MPa] where each drives
+    flank_force_max: tuple[Extreme, Extreme] | None = None
+    flank_stress_max: tuple[Extreme, Extreme] | None = None
 
     csv_header: ClassVar[tuple[str, ...]] = CSV_HEADER
 
@@ -129,8 +148,15 @@ class DynamicsResult:
             (``"before joint"``/``"after joint"`` for a one-sided limit, else
             ``None``); then ``jump`` (bool), ``jump_range_deg`` ([start, end]
             in degrees, start > end through 0°, or ``None``),
-            ``min_preload_N``, ``speed_range_rpm`` ([low, high] or ``None``)
-            and ``warnings`` (list of str). Plain Python values, JSON-ready.
+            ``min_preload_N``, ``speed_range_rpm`` ([low, high] or ``None``;
+            both left out for positive drive, where no jump check applies)
+            and ``warnings`` (list of str). A groove adds
+            ``hertz_stress_max_flank`` (``"inner"`` or ``"outer"``, the flank
+            that carries the peak) and ``flanks``: for each flank the largest
+            load it carries where it drives (``contact_force_max_N``) and its
+            largest Hertz stress (``hertz_stress_max_MPa``), with angles and
+            sides; the signed ``contact_force_*`` are positive where the
+            inner flank drives. Plain Python values, JSON-ready.
         """
         arc = self.jump_range
         out: dict[str, Any] = {}
@@ -147,17 +173,35 @@ class DynamicsResult:
             out[f"{key}_{unit}"] = ext.value
             out[f"{key}_angle_deg"] = round(ext.angle_deg, 6)
             out[f"{key}_side"] = None if ext.side is None else SIDE_WORDS[ext.side]
-        out |= {
-            "jump": self.jump,
-            "jump_range_deg": None if arc is None else [_deg(arc[0]), _deg(arc[1])],
-            ("min_preload_N" if self.preload_unit == "N" else "min_preload_N_mm"): self.min_preload,
-            "speed_range_rpm": None if self.speed_range_rpm is None else list(self.speed_range_rpm),
-            "warnings": list(self.warnings),
-        }
+        out |= {"jump": self.jump, "jump_range_deg": None if arc is None else [_deg(arc[0]), _deg(arc[1])]}
+        if not self.positive_drive:  # the spring's preload and the speed range keep a spring-held follower on
+            out |= {
+                ("min_preload_N" if self.preload_unit == "N" else "min_preload_N_mm"): self.min_preload,
+                "speed_range_rpm": None if self.speed_range_rpm is None else list(self.speed_range_rpm),
+            }
+        out["warnings"] = list(self.warnings)
+        if self.flank_force_max is not None and self.flank_stress_max is not None:
+            out["hertz_stress_max_flank"] = self.hertz_stress_flank
+            out["flanks"] = {
+                name: _flank(force, peak)
+                for name, force, peak in zip(
+                    FLANK_WORDS, self.flank_force_max, self.flank_stress_max, strict=True
+                )
+            }
         if self.crossovers:
             out["crossover_angles_deg"] = [_deg(p) for p in self.crossovers]
-            out["impact_speed_max_mm_per_s"] = max(self.impact_speeds, default=None)
+            # a massless follower has no free flight (NaN): no figure
+            out["impact_speed_max_mm_per_s"] = max(
+                (v for v in self.impact_speeds if math.isfinite(v)), default=None
+            )
         return out
+
+    @property
+    def hertz_stress_flank(self) -> str | None:
+        """A groove's flank that carries the peak Hertz stress (``"inner"``/``"outer"``), else None."""
+        if self.flank_stress_max is None:
+            return None
+        return FLANK_WORDS[0 if self.flank_stress_max[0].value >= self.flank_stress_max[1].value else 1]
 
     def table(self) -> FloatArray:
         """(n, 4) array of the ``dynamics.csv`` columns (see ``csv_header``).

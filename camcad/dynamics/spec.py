@@ -82,6 +82,13 @@ class DynamicsSetup:
         over, which is a crossover, not a jump.
     clearance
         A groove's radial clearance [mm] (the impact estimate at crossovers).
+    flank_offsets
+        A groove's inner and outer flank as offsets of the profile [mm]
+        (:func:`camcad.geometry.groove.flank_offsets`), None for any other
+        cam: where the contact force is positive the inner flank drives (the
+        roller outside it, ρ_inner = ρ + d_inner), where it is negative the
+        outer flank (the roller inside it, conformal: 1/R* = 1/r_f − 1/ρ_outer),
+        and every contact figure is taken on that flank.
     drive_sign
         −1 for a conjugate pair's second plate: its roller pushes the follower
         back, so its contact force is the generalised force with the sign turned.
@@ -101,3 +108,4 @@ class DynamicsSetup:
     positive_drive: bool = False
     clearance: float = 0.0
     drive_sign: float = 1.0
+    flank_offsets: tuple[float, float] | None = None

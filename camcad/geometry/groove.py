@@ -33,7 +33,7 @@ from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
 
-__all__ = ["GrooveAnalysis", "analyse_groove", "flank_offsets", "groove_flanks"]
+__all__ = ["GrooveAnalysis", "analyse_groove", "flank_offsets", "groove_flanks", "roller_flank_offsets"]
 
 
 def groove_flanks(
@@ -55,8 +55,12 @@ def flank_offsets(cam: Cam, clearance: float) -> tuple[float, float]:
     −(r_f + c/2) from the pitch curve, is the profile offset by −c/2, and the
     outer flank, at +(r_f + c/2), is the profile offset by 2r_f + c/2.
     """
-    r_f = cam.roller_radius
-    return -0.5 * clearance, 2.0 * r_f + 0.5 * clearance
+    return roller_flank_offsets(cam.roller_radius, clearance)
+
+
+def roller_flank_offsets(roller_radius: float, clearance: float) -> tuple[float, float]:
+    """:func:`flank_offsets` from the roller radius r_f [mm] and the clearance c [mm] alone."""
+    return -0.5 * clearance, 2.0 * roller_radius + 0.5 * clearance
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

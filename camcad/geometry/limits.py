@@ -65,8 +65,11 @@ class GeometryAnalysis:
     pressure_angle_max: Extreme  # of |α| [rad]
     profile_radius_min: Extreme  # polar radius of the contact point [mm]
     profile_radius_max: Extreme
-    curvature_radius_min: Extreme | None  # smallest convex profile radius [mm]; None if none convex
-    concave_radius_min: Extreme | None  # smallest concave profile radius [mm] (positive); None if none
+    # smallest convex profile radius [mm], signed: < 0 where the profile loops (roller) or has a
+    # cusp (flat face); None if none convex
+    curvature_radius_min: Extreme | None
+    # smallest concave profile radius [mm] (positive), a loop or cusp not counted; None if none
+    concave_radius_min: Extreme | None
 
     @property
     def warnings(self) -> tuple[str, ...]:
@@ -102,11 +105,6 @@ def _put(out: dict[str, Any], key: str, ext: Extreme | None, *, unit: str, scale
     out[f"{key}_{unit}"] = None if ext is None else ext.value * scale
     out[f"{key}_angle_deg"] = None if ext is None else ext.angle_deg
     out[f"{key}_side"] = None if ext is None or ext.side is None else SIDE_WORDS[ext.side]
-
-
-def _convex(rho: FloatArray) -> FloatArray:
-    """ρ where convex, +inf elsewhere (for the smallest convex radius)."""
-    return np.where(rho > 0.0, rho, np.inf)
 
 
 def _concave(rho: FloatArray) -> FloatArray:
@@ -287,9 +285,10 @@ def analyse_geometry(
         rho = st.profile.rho
         undercut = cam.loop_radius(st)
         x = st.contact_position
-        return np.vstack(
-            (np.abs(st.pressure_angle), radius, radius, _convex(rho), _concave(rho), undercut, x, x)
-        )
+        # the convex side runs on into a loop or cusp with ρ < 0: its minimum is the true signed one
+        convex = np.where(np.isfinite(undercut), rho, np.inf)
+        concave = np.where(np.isfinite(undercut), np.inf, _concave(rho))
+        return np.vstack((np.abs(st.pressure_angle), radius, radius, convex, concave, undercut, x, x))
 
     values = rows(phi, "right")
     alpha_max, radius_min, radius_max, convex_min, concave_min, worst, reach_min, reach_max = extremes_rows(
@@ -365,6 +364,8 @@ def _velocity_jumps(cam: Cam) -> list[Finding]:
     rests, typically).
     """
     out = []
+    unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    shown = "°" if unit == "deg" else unit
     for joint in cam.program.joints():
         if joint.continuity > 0:
             continue
@@ -379,14 +380,14 @@ def _velocity_jumps(cam: Cam) -> list[Finding]:
                 field=f"motion[{k}].law",
                 message=(
                     f"motion[{k}].law: {name!r} makes the follower velocity jump by "
-                    f"{joint.dv:+.4g} mm/rad at {math.degrees(joint.phi):.1f}°, an infinite acceleration "
-                    "and a corner in the profile; use a law that starts and ends at rest "
+                    f"{joint.dv:+.4g} {shown}/rad at {math.degrees(joint.phi):.1f}°, an infinite "
+                    "acceleration and a corner in the profile; use a law that starts and ends at rest "
                     "('cycloidal', 'modified-trapezoid', 'modified-sine', 'poly-345')"
                 ),
                 angle=joint.phi,
                 value=joint.dv,
                 limit=0.0,
-                unit="mm/rad",
+                unit=f"{unit}/rad",
             )
         )
     return out
@@ -402,10 +403,16 @@ def _reversals(cam: Cam) -> list[Finding]:
     for the end velocities its neighbours ask for (it must overshoot to meet
     them), and so can a point table. The worst backward ds/dφ is the true
     extreme: the densest sample refined by bounded minimisation (Brent) on the
-    exact motion.
+    exact motion. A segment that starts (or ends) moving the other way, as a
+    return out of a constant-velocity rise must, carries the follower beyond
+    its own start (or end): that run is reported too, with the true extreme
+    the follower reaches (where ds/dφ = 0, by Brent's method), so the stroke
+    beyond the nominal lift is never silent.
     """
     out = []
     program = cam.program
+    unit = cam.follower.kind.lift_unit
+    shown = "°" if unit == "deg" else unit
     for k, (seg, start) in enumerate(zip(program.segments, program.starts, strict=True)):
         if seg.kind.value not in ("rise", "return") or seg.lift <= 0.0:
             continue
@@ -414,13 +421,15 @@ def _reversals(cam: Cam) -> list[Finding]:
         back = -sense * cam.motion(start + x * seg.span).v  # > 0 where the follower runs backwards
         wrong = back > _REVERSAL_RTOL * seg.lift / seg.span
         # a segment that starts or ends moving the other way (a return out of a constant-velocity
-        # rise) must run that way next to that end: only a backward run inside the segment is a flaw
+        # rise) runs that way next to that end: reported as an overshoot beyond that end
         inherited = np.zeros_like(wrong)
         for edge, step in ((0, 1), (x.size - 1, -1)):
             i = edge
             while 0 <= i < x.size and wrong[edge] and wrong[i]:
                 inherited[i] = True
                 i += step
+            if wrong[edge]:
+                out.append(_overshoot(cam, k, start, seg.span, x, i - step, i, edge == 0, shown))
         back = np.where(wrong & ~inherited, back, 0.0)
         worst = int(np.argmax(back))
         if back[worst] <= 0.0:
@@ -436,7 +445,6 @@ def _reversals(cam: Cam) -> list[Finding]:
         phi = start + float(res.x) * seg.span
         value = max(-sense * float(res.fun), float(back[worst]))
         span = np.degrees(start + x[back > 0.0] * seg.span)
-        unit = cam.follower.kind.lift_unit
         out.append(
             Finding(
                 kind="motion reversal",
@@ -444,7 +452,7 @@ def _reversals(cam: Cam) -> list[Finding]:
                 field=f"motion[{k}].lift",
                 message=(
                     f"motion[{k}].lift: the {seg.kind.value} runs backwards between {span.min():.1f}° and "
-                    f"{span.max():.1f}° (ds/dφ = {-sense * value:+.4g} {unit}/rad at "
+                    f"{span.max():.1f}° (ds/dφ = {-sense * value:+.4g} {shown}/rad at "
                     f"{math.degrees(phi):.1f}°): "
                     "its law must overshoot to meet the velocities of its neighbours; give it more lift or a "
                     "longer angle"
@@ -456,6 +464,50 @@ def _reversals(cam: Cam) -> list[Finding]:
             )
         )
     return out
+
+
+def _overshoot(
+    cam: Cam, k: int, start: float, span: float, x: FloatArray, last: int, first: int, head: bool, shown: str
+) -> Finding:
+    """The finding for segment k running the other way next to one end, out to the turning point.
+
+    ``x[last]`` is the last sample (fraction of the span) of the run from the
+    end, ``x[first]`` the first one past it (or off the segment when the run
+    covers it all); the turning point, ds/dφ = 0, lies between them and is
+    found by Brent's method on the exact motion.
+    """
+    seg = cam.program.segments[k]
+    lo, hi = sorted((float(x[last]), float(x[min(max(first, 0), x.size - 1)])))
+
+    def v(u: float) -> float:
+        return float(cam.motion(np.array([start + u * span])).v[0])
+
+    turn = brent_root(v, lo, hi, xtol=1e-13) if v(lo) * v(hi) < 0.0 else (hi if head else lo)
+    edge = start if head else start + span
+    side: Side = "right" if head else "left"
+    s_edge = float(cam.motion(np.array([edge]), side=side).s[0])
+    phi = start + turn * span
+    s_turn = float(cam.motion(np.array([phi])).s[0])
+    beyond = abs(s_turn - s_edge)
+    way = "forwards" if seg.kind.value == "return" else "backwards"
+    where = "start" if head else "end"
+    first_deg, last_deg = sorted((math.degrees(edge), math.degrees(phi)))
+    unit = cam.follower.kind.lift_unit
+    return Finding(
+        kind="motion reversal",
+        severity=Severity.SOFT,
+        field=f"motion[{k}].lift",
+        message=(
+            f"motion[{k}].lift: the {seg.kind.value} runs {way} between {first_deg:.1f}° and {last_deg:.1f}° "
+            f"at the {where}, carried by the speed it matches there, to {s_turn:.3f} {shown} at "
+            f"{math.degrees(phi) % 360.0:.1f}°, {beyond:.3f} {shown} beyond its {where}, outside the "
+            "travel its lift states; give the segment more angle or its neighbour a lower end speed"
+        ),
+        angle=phi % TWO_PI,
+        value=beyond,
+        limit=0.0,
+        unit=unit,
+    )
 
 
 def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 0.0) -> UndercutError:

@@ -104,18 +104,23 @@ class Joint:
     continuity: int
     internal: bool = False  # inside a segment, where its law switches formula
 
-    def describe(self) -> str:
-        """One line a user reads, e.g. ``acceleration jumps by 0.85 mm/rad² at 150°``."""
+    def describe(self, unit: str = "mm") -> str:
+        """One line a user reads, e.g. ``acceleration jumps by 0.85 mm/rad² at 150°``.
+
+        ``unit`` is the lift's unit as shown: ``"mm"`` on a slide, ``"°"`` (or
+        ``"deg"``) of swing on an arm.
+        """
         deg = math.degrees(self.phi)
         where = " (inside the segment)" if self.internal else ""
+        u = "°" if unit == "deg" else unit
         parts = []
-        for name, unit, value in (
-            ("velocity", "mm/rad", self.dv),
-            ("acceleration", "mm/rad²", self.da),
-            ("jerk", "mm/rad³", self.dj),
+        for name, shown, value in (
+            ("velocity", f"{u}/rad", self.dv),
+            ("acceleration", f"{u}/rad²", self.da),
+            ("jerk", f"{u}/rad³", self.dj),
         ):
             if value != 0.0:
-                parts.append(f"{name} jumps by {value:+.4g} {unit}")
+                parts.append(f"{name} jumps by {value:+.4g} {shown}")
         if not parts:
             return f"{deg:g}°{where}: smooth (s, v, a, j continuous)"
         return f"{deg:g}°{where}: " + ", ".join(parts)

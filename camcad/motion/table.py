@@ -83,8 +83,9 @@ class TableFlag:
         """One line, e.g. ``'41.0°: acceleration off by +3.1 mm/rad² (noise explains 0.8)'``."""
         power = {"lift": "", "acceleration": "/rad²", "jerk": "/rad³"}[self.quantity]
         what = "lift" if self.quantity == "lift" else f"table {self.quantity}"
+        shown = "°" if unit == "deg" else unit  # an arm's lift is in degrees of swing
         return (
-            f"{math.degrees(self.angle):.3f}°: {what} off the smooth law by {self.value:+.4g} {unit}{power} "
+            f"{math.degrees(self.angle):.3f}°: {what} off the smooth law by {self.value:+.4g} {shown}{power} "
             f"(the stated noise explains {self.limit:.3g})"
         )
 

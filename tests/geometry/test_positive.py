@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
 from camcad.design import parse_design
@@ -278,27 +279,114 @@ def test_crossovers_of_a_groove_slide_where_inertia_balances_weight() -> None:
     assert sorted(result.dynamics.crossovers) == pytest.approx(expected, abs=1e-9)
 
 
+def _free_flight_speed(
+    cam: Cam, phi0: float, omega: float, c: float, lever: float | None, accel: Any
+) -> float:
+    """Normal approach speed [mm/s] when the free follower meets a flank, integrated by LSODA.
+
+    The follower's own equation of motion q̈ = accel(q) (q in mm, or in rad of
+    swing on an arm), started on the groove's path with its speed; the gap to
+    the path along the common normal is (q − q_cam)·L·cos α (L = 1 on a slide,
+    the lever on an arm), and a flank is met at |gap| = c, or back at 0.
+    """
+    deg = lever is not None
+    k = math.pi / 180.0 if deg else 1.0  # the motion's unit (° of swing) to rad
+
+    def cam_at(t: float) -> tuple[float, float, float]:
+        st = cam.state(np.array([phi0 + omega * t]), side="right")
+        length = (float(st.lever[0]) if deg else 1.0) * math.cos(float(st.pressure_angle[0]))
+        return float(st.motion.s[0]) * k, float(st.motion.v[0]) * k * omega, length
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        return [y[1], accel(y[0])]
+
+    def gap(t: float, y: np.ndarray) -> float:
+        q, _, length = cam_at(t)
+        return (y[0] - q) * length
+
+    def far(t: float, y: np.ndarray) -> float:
+        return abs(gap(t, y)) - c
+
+    def home(t: float, y: np.ndarray) -> float:  # back on the flank it left (past round-off in q − q_cam)
+        return gap(t, y) * lead + 1e-6 * c
+
+    far.terminal = home.terminal = True
+    q0, dq0, _ = cam_at(0.0)
+    probe = solve_ivp(rhs, (0.0, 1e-3), [q0, dq0], method="LSODA", rtol=1e-12, atol=1e-15)
+    lead = math.copysign(1.0, gap(1e-3, probe.y[:, -1]))  # the side it drifts to
+    home.direction = -1.0
+    sol = solve_ivp(
+        rhs,
+        (0.0, 2.0 * math.pi / omega),
+        [q0, dq0],
+        method="LSODA",
+        rtol=1e-12,
+        atol=1e-15,
+        events=(far, home),
+        max_step=1e-3,
+    )
+    t, y = next((te[0], ye[0]) for te, ye in zip(sol.t_events, sol.y_events, strict=True) if te.size)
+    _, dq, length = cam_at(t)
+    return abs(y[1] - dq) * length
+
+
 def test_impact_speed_against_the_free_flight_across_the_clearance() -> None:
+    # the sample: an arm with nothing but its inertia, which flies straight on
     design = parse_design_file("groove_rocker.toml")
     result = analyse(design, fit=False, toolpath=False)
-    cam, c = result.cam, design.groove.clearance
-    omega = design.cam.omega
-    lever = design.follower.arm_length
     crossovers, speeds = result.dynamics.crossovers, result.dynamics.impact_speeds
     assert crossovers and len(speeds) == len(crossovers)
     for phi0, speed in zip(crossovers, speeds, strict=True):
-        # the arm floats at the crossover's angular speed; the groove keeps to the exact law
-        m0 = cam.motion(np.array([phi0]))
-        psi0, dpsi0 = float(m0.s[0]), float(m0.v[0])
+        expected = _free_flight_speed(
+            result.cam, phi0, design.cam.omega, design.groove.clearance, 100.0, lambda q: 0.0
+        )
+        assert speed == pytest.approx(expected, rel=1e-6)
 
-        def gap(dphi: float, phi0: float = phi0, psi0: float = psi0, dpsi0: float = dpsi0) -> float:
-            # mm at the roller, between the groove's path and the free arm
-            psi = float(cam.motion(np.array([phi0 + dphi])).s[0])
-            return abs(psi - psi0 - dpsi0 * dphi) * math.pi / 180.0 * lever - c
 
-        hit = brentq(gap, 1e-9, 0.3)
-        rel = abs(float(cam.motion(np.array([phi0 + hit])).v[0]) - dpsi0) * omega * math.pi / 180.0 * lever
-        assert speed == pytest.approx(rel, rel=0.02)
+@pytest.mark.parametrize("spring", [(0.0, 0.0), (0.3, 2.0)], ids=["weight", "spring"])
+def test_impact_speed_of_a_slide_under_weight_and_spring(spring: tuple[float, float]) -> None:
+    # m·ẍ = −(m·g + k·x + F0) in N with ẍ in mm/s² / 1000: the spring and weight act in the flight
+    rate, preload = spring
+    mass, c = 2.0, 0.05
+    design = _design(
+        "groove",
+        SLIDE,
+        [dict(m) for m in RDRD],
+        cam={"outer_radius": 120.0, "speed_rpm": 300.0},
+        groove={"clearance": c},
+        dynamics={"follower_mass": mass, "spring_rate": rate, "spring_preload": preload},
+    )
+    result = analyse(design, fit=False, toolpath=False)
+    crossovers, speeds = result.dynamics.crossovers, result.dynamics.impact_speeds
+    assert len(crossovers) >= 2 and len(speeds) == len(crossovers)
+
+    def accel(x: float) -> float:
+        return -1000.0 * (mass * 9.80665 + rate * x + preload) / mass
+
+    for phi0, speed in zip(crossovers, speeds, strict=True):
+        expected = _free_flight_speed(result.cam, phi0, design.cam.omega, c, None, accel)
+        assert speed == pytest.approx(expected, rel=1e-6)
+
+
+def test_impact_speed_of_an_arm_with_a_torsion_spring() -> None:
+    # I·ψ̈ / 1000 = −(k_t·ψ + M0) [N·mm], ψ in rad: the spring pulls the free arm back
+    inertia, k_t, m0 = 8000.0, 3000.0, 150.0
+    design = _design(
+        "groove",
+        ARM,
+        [dict(m) for m in RDRD],
+        cam={"outer_radius": 140.0, "speed_rpm": 240.0, "base_radius": 52.0},
+        groove={"clearance": 0.03},
+        dynamics={"arm_inertia": inertia, "spring_rate_torsional": k_t, "spring_preload_torsional": m0},
+    )
+    result = analyse(design, fit=False, toolpath=False)
+    crossovers, speeds = result.dynamics.crossovers, result.dynamics.impact_speeds
+    assert crossovers and len(speeds) == len(crossovers)
+    for phi0, speed in zip(crossovers, speeds, strict=True):
+        expected = _free_flight_speed(
+            result.cam, phi0, design.cam.omega, 0.03, 100.0, lambda psi: -1000.0 * (k_t * psi + m0) / inertia
+        )
+        assert speed == pytest.approx(expected, rel=1e-6)
 
 
 def parse_design_file(name: str) -> Any:

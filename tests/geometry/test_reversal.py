@@ -41,6 +41,7 @@ def _findings(design):
 
 def test_a_short_rise_into_speed_runs_backwards_and_is_reported() -> None:
     cam, found = _findings(_web_cutter(10.0))
+    found = [f for f in found if f.field == "motion[1].lift"]  # the return's overshoot: below
     assert len(found) == 1
     (f,) = found
     assert f.field == "motion[1].lift" and not f.hard
@@ -52,6 +53,24 @@ def test_a_short_rise_into_speed_runs_backwards_and_is_reported() -> None:
 
 
 def test_enough_lift_is_monotone_and_fixed_laws_never_reverse() -> None:
-    assert _findings(_web_cutter(20.0))[1] == []
+    assert [f for f in _findings(_web_cutter(20.0))[1] if f.field == "motion[1].lift"] == []
     for law in ("cycloidal", "harmonic", "poly-345", "modified-sine", "modified-trapezoid"):
         assert _findings(make_design(law=law))[1] == []
+
+
+def test_a_return_out_of_speed_runs_forwards_beyond_its_start_and_is_reported() -> None:
+    # issue 31: the return carries on at the constant-velocity stretch's speed before it turns back;
+    # truth: the highest s on 10⁶ angles of the return, refined where ds/dφ = 0 by brentq
+    from scipy.optimize import brentq
+
+    cam, found = _findings(_web_cutter(20.0))
+    (f,) = [f for f in found if f.field == "motion[3].lift"]
+    assert not f.hard and f.unit == "mm" and "runs forwards" in f.message
+    phi = np.linspace(math.radians(180.0), math.radians(300.0), 1_000_001)
+    s = cam.motion(phi).s
+    i = int(np.argmax(s))
+    top = brentq(lambda p: float(cam.motion(np.array([p])).v[0]), phi[i - 1], phi[i + 1], xtol=1e-14)
+    start = float(cam.motion(np.array([math.radians(180.0)])).s[0])
+    assert f.angle == pytest.approx(top, abs=1e-9)
+    assert f.value == pytest.approx(float(cam.motion(np.array([top])).s[0]) - start, abs=1e-9)
+    assert f.value > 10.0  # the sample's return overshoots by about 10.4 mm
