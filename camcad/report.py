@@ -356,8 +356,13 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
     gcode = analysis.gcode.summary() if analysis.gcode is not None else None
     if gcode is not None:
         minutes = float(gcode.get("cycle_time_s", 0.0)) / 60.0
+        tool = f"tool D{_num(float(gcode.get('tool_diameter_mm', 0.0)), 'g')} mm" + (
+            " (chosen by camcad to fit the groove)" if gcode.get("tool_chosen") else ""
+        )
         gcode_card = _card(
-            "G-code", f"{gcode.get('blocks')} blocks", f"{gcode.get('arcs')} arcs, about {minutes:.1f} min"
+            "G-code",
+            f"{gcode.get('blocks')} blocks",
+            f"{gcode.get('arcs')} arcs, about {minutes:.1f} min; {tool}",
         )
     cards = [
         _card("Arm swing", f"{k['lift']:.3f}°")
