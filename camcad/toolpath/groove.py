@@ -295,7 +295,8 @@ def plan_groove(
     if clearing:
         sides = {w: sum(1 for _, x in clearing if x == w) for w in ("inner", "outer")}
         notes.append(
-            f"clearing: {sides['inner']} pass(es) towards the inner flank, {sides['outer']} towards the outer, "
+            f"clearing: {sides['inner']} pass(es) towards the inner flank, "
+            f"{sides['outer']} towards the outer, "
             f"at most {r:.4f} apart (50% stepover), each at every slot level, entered along the normal "
             "at the start angle from the centre line"
         )
