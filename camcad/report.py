@@ -125,7 +125,7 @@ footer { margin-top: 30px; color: var(--muted); font-size: 12px; }
   .card { padding: 4px 7px; }
   .card .value { font-size: 12pt; }
   .card .label, .card .note { font-size: 7.5pt; }
-  .plots { display: block; }
+  .plots { display: block; orphans: 1; widows: 1; }  /* a row of figures is one line: break after any */
   .plots figure { display: inline-block; width: calc(50% - 4px); vertical-align: top; break-inside: avoid;
                   margin: 0 0 6px; padding: 4px; }
   .plots figure img { max-height: 56mm; width: auto; max-width: 100%; margin: 0 auto; }

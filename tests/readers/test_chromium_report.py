@@ -106,7 +106,7 @@ def test_printed_fe_case_table_keeps_words_whole_and_its_last_column(tmp_path):
     """Issue 31: in print the FE load-case table wrapped "where" one letter per line and clipped its last
     column, and the "value" header wrapped. Printed by ``chromium --headless --print-to-pdf``, read back
     by pdftotext: every header word and every word of the "where" cells is whole, the last column's
-    header and every case's value in it are on the page."""
+    header and every case's value in it are on the page, and page 1 goes on into the plots."""
     pytest.importorskip("gmsh")
     pytest.importorskip("skfem")
     binary = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -136,3 +136,6 @@ def test_printed_fe_case_table_keeps_words_whole_and_its_last_column(tmp_path):
         last = fmt(case.get(keys[-1]), split_unit(keys[-1])[1])
         assert all(part in text for part in last.replace(",", " ").split()), (keys[-1], last)
     assert "value" in words  # the quantity tables' header, unbroken
+    # page 1 is filled: the first plot follows the key numbers (it left 40 % of the page empty)
+    first = subprocess.run(["pdftotext", "-f", "1", "-l", "1", str(pdf), "-"], capture_output=True, text=True)
+    assert "Follower motion." in first.stdout
