@@ -272,7 +272,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from camcad.pipeline import analyse
 
     design = load_design(args.design)
-    analysis = analyse(design, strict=False, toolpath=True, fea=args.fea or design.fea is not None)
+    # check does not depend on the [gcode] options: it plans no toolpath (build does)
+    analysis = analyse(design, strict=False, toolpath=False, fea=args.fea or design.fea is not None)
     rows = _check_rows(analysis.summary(), design) + _positive_rows(analysis.summary())
     rows += _duty_rows(analysis.summary())
     if analysis.fea is not None:

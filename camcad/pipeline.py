@@ -606,7 +606,11 @@ def _write_steps(analysis: Analysis, folder: Path) -> list[Path]:
         body = groove_body(flanks, plate, outer_radius=design.cam.outer_radius, depth=design.groove.depth)
         return [write_step(folder / "cam.step", [body])]
     plates = _plates(analysis)
-    return [write_cam_step(folder / f"cam{suffix}.step", fit=fit, plate=plate) for suffix, _, fit in plates]
+    parts = range(1, 3) if len(plates) == 2 else (0,)  # a pair: named "plate 1"/"plate 2", placed as mounted
+    return [
+        write_cam_step(folder / f"cam{suffix}.step", fit=fit, plate=plate, part=part)
+        for (suffix, _, fit), part in zip(plates, parts, strict=True)
+    ]
 
 
 def write_tables(analysis: Analysis, folder: Path) -> list[Path]:

@@ -120,16 +120,20 @@ footer { margin-top: 30px; color: var(--muted); font-size: 12px; }
   h2 { margin: 12px 0 6px; font-size: 12pt; break-after: avoid; }
   .alert { margin-top: 8px; padding: 6px 10px; }
   .glance { grid-template-columns: minmax(0, 3fr) minmax(0, 2fr); gap: 8px; margin-top: 8px; }
-  .glance figure img { max-height: 118mm; width: auto; max-width: 100%; margin: 0 auto; }
+  .glance figure img { max-height: 92mm; width: auto; max-width: 100%; margin: 0 auto; }
   .cards { grid-template-columns: repeat(2, minmax(0, 1fr)); gap: 5px; }
   .card { padding: 4px 7px; }
   .card .value { font-size: 12pt; }
   .card .label, .card .note { font-size: 7.5pt; }
-  .plots { display: block; }
-  .plots figure { break-inside: avoid; margin: 0 0 6px; padding: 4px; }
-  .plots figure img { max-height: 96mm; width: auto; max-width: 100%; margin: 0 auto; }
+  .plots { display: block; orphans: 1; widows: 1; }  /* a row of figures is one line: break after any */
+  .plots figure { display: inline-block; width: calc(50% - 4px); vertical-align: top; break-inside: avoid;
+                  margin: 0 0 6px; padding: 4px; }
+  .plots figure img { max-height: 56mm; width: auto; max-width: 100%; margin: 0 auto; }
   figure { border-color: #ccc; }
   .scroll { overflow: visible; }
+  th, td { overflow-wrap: normal; word-break: normal; hyphens: manual; }
+  .records table { width: auto; max-width: 100%; font-size: 6.5pt; }
+  .records th, .records td { padding: 1px 2px; }
   .tables { display: block; column-count: 2; column-gap: 6mm; }
   .tables > .wide { column-span: all; }
   table { width: 100%; font-size: 8pt; }
@@ -387,8 +391,13 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
     gcode = analysis.gcode.summary() if analysis.gcode is not None else None
     if gcode is not None:
         minutes = float(gcode.get("cycle_time_s", 0.0)) / 60.0
+        tool = f"tool D{_num(float(gcode.get('tool_diameter_mm', 0.0)), 'g')} mm" + (
+            " (chosen by camcad to fit the groove)" if gcode.get("tool_chosen") else ""
+        )
         gcode_card = _card(
-            "G-code", f"{gcode.get('blocks')} blocks", f"{gcode.get('arcs')} arcs, about {minutes:.1f} min"
+            "G-code",
+            f"{gcode.get('blocks')} blocks",
+            f"{gcode.get('arcs')} arcs, about {minutes:.1f} min; {tool}",
         )
     shown = "°" if cam.follower.kind.oscillating else " mm"
     stroke_note = ""
@@ -470,7 +479,7 @@ def _records_table(records: Sequence[Mapping[str, Any]]) -> str:
         keys += [k for k in rec if k not in keys]
     header = [_e(label(k)) for k in keys]
     rows = [[_e(fmt(rec.get(k), split_unit(k)[1])) for k in keys] for rec in records]
-    return f'<div class="scroll">{_table(header, rows)}</div>'
+    return f'<div class="scroll records">{_table(header, rows)}</div>'
 
 
 _SECTION_TITLES = {"gcode": "G-code", "fit": "NURBS fit", "second_plate": "Second plate"}
@@ -486,7 +495,8 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
             continue
         title = _SECTION_TITLES.get(name, name.replace("_", " ").capitalize())
         body = _quantities_table(section, skip=("warnings", "joints"))
-        out.append(f'<div id="table-{_e(name)}"><h3>{_e(title)}</h3>{body}</div>')
+        wide = ' class="wide"' if 'class="scroll records"' in body else ""  # a records table: full width
+        out.append(f'<div id="table-{_e(name)}"{wide}><h3>{_e(title)}</h3>{body}</div>')
     motion = summary.get("motion", {})
     joints = motion.get("joints")
     if joints:

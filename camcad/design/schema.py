@@ -1104,6 +1104,8 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
     specs: dict[str, Any] = {}
     for name, cls in _SPEC_CLASSES.items():
         specs[name] = cls(**_section(name, data.get(name, {})))
+    if "tool_diameter" not in data.get("gcode", {}):  # a groove cam then gets a cutter that fits it
+        specs["gcode"] = dataclasses.replace(specs["gcode"], choose_tool=True)
     if "fea" in data:  # present or not decides whether a build runs the FE check
         specs["fea"] = FeaSpec(**_section("fea", data["fea"]))
     specs |= _service_tables(data)  # [life], [lubrication], [drive] (issue 35)

@@ -17,6 +17,7 @@ from typing import Protocol
 import numpy as np
 
 from camcad._typing import FloatArray, readonly
+from camcad.errors import DesignError
 from camcad.fit.curve import BSplineCurve, curve_derivatives
 from camcad.toolpath.arcs.biarc import (
     CurveFn,
@@ -32,6 +33,7 @@ __all__ = [
     "arc_outline",
     "bspline_area",
     "bspline_length",
+    "chord_budget",
     "flatten_bspline",
     "flatten_curve",
     "knot_spans",
@@ -39,6 +41,36 @@ __all__ = [
     "polygon_area",
     "polygon_perimeter",
 ]
+
+
+MIN_CHORD_BUDGET = 1e-4
+"""Smallest chord error [mm] left for a polyline after the fit's (the schema's finest chord_tolerance)."""
+
+
+def chord_budget(chord_tolerance: float, fit_error: float, *, field: str) -> float:
+    """Chord error [mm] left for a fitted curve's polyline within ``chord_tolerance`` of the truth.
+
+    The polyline is flattened from the fitted spline, which lies within its
+    certified ``fit_error`` [mm] of the exact curve, so by the triangle
+    inequality a chord error of ``chord_tolerance − fit_error`` keeps every
+    vertex and chord within ``chord_tolerance`` of the exact curve.
+
+    Raises
+    ------
+    DesignError
+        ``field`` (``dxf.chord_tolerance`` or ``mesh.chord_tolerance``) when
+        less than :data:`MIN_CHORD_BUDGET` is left: the fit alone uses the
+        budget; the message names the fit's error and what is allowed.
+    """
+    budget = chord_tolerance - fit_error
+    if budget < MIN_CHORD_BUDGET:
+        raise DesignError(
+            field,
+            f"{chord_tolerance:g} mm leaves no chord error for the polyline: the fitted spline is already "
+            f"up to {fit_error:.6f} mm from the exact profile; allowed: a chord_tolerance of at least "
+            f"{fit_error + MIN_CHORD_BUDGET:.6f} mm, or a finer fit.tolerance",
+        )
+    return budget
 
 
 def polygon_area(points: FloatArray) -> float:

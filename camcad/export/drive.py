@@ -22,6 +22,11 @@ from the exact motion program (not from sampled or fitted data), at
 
 ``<u>`` is ``mm`` on a slide and ``deg`` (degrees of arm swing) on an arm. At a
 joint where the motion itself jumps, the value after the joint is written.
+
+Every value is written in fixed notation with :data:`DECIMALS` decimals
+(drive software reads no e-notation), rounded half to even, so each cell is
+within 0.5e-9 of the exact value; a value that rounds to zero is written
+``0.000000000``, never ``-0.000000000``.
 """
 
 from __future__ import annotations
@@ -37,10 +42,12 @@ from camcad.export.records import write_csv
 from camcad.export.spec import DriveLayout
 from camcad.motion.program import MotionProgram
 
-__all__ = ["drive_table", "write_drive_table"]
+__all__ = ["DECIMALS", "drive_table", "write_drive_table"]
 
 _DEG = math.pi / 180.0
-_FORMAT = "{:.9g}"
+DECIMALS = 9
+"""Decimals of every cell of ``cam_table.csv`` (fixed notation)."""
+_FORMAT = f"{{:.{DECIMALS}f}}"
 
 
 def drive_table(
@@ -104,6 +111,7 @@ def write_drive_table(
     layout: DriveLayout = DriveLayout.FULL,
     unit: str = "mm",
 ) -> Path:
-    """Atomically write ``cam_table.csv`` (see :func:`drive_table`); nine significant digits."""
+    """Atomically write ``cam_table.csv`` (:func:`drive_table`), fixed notation, :data:`DECIMALS` decimals."""
     cols = drive_table(program, points, layout=layout, unit=unit)
-    return write_csv(path, cols, formats=[_FORMAT] * len(cols))
+    fixed = {k: np.round(v, DECIMALS) + 0.0 for k, v in cols.items()}  # + 0.0: no "-0.000000000"
+    return write_csv(path, fixed, formats=[_FORMAT] * len(fixed))

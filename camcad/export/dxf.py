@@ -12,8 +12,11 @@ for which program"):
   ARCs (and LINEs), within the fit tolerance, for CNC controllers and CAM
   importers that do not read splines.
 
-No file holds construction geometry as a closed outline: a program that
-extrudes every closed contour it finds (OpenSCAD) extrudes only the part.
+No file holds construction geometry as a closed outline, and ``profile.dxf``
+holds nothing but SPLINEs, LINEs and TEXT: OpenSCAD, which extrudes every
+LWPOLYLINE, CIRCLE and ARC it finds (open ones closed into slivers) and skips
+SPLINE, extrudes the whole part from the cutting files and nothing from
+``profile.dxf``.
 
 ``profile.dxf`` (DXF R2010, millimetres) holds, by layer:
 
@@ -25,21 +28,27 @@ extrudes every closed contour it finds (OpenSCAD) extrudes only the part.
     conditions, and LibreCAD and ezdxf's renderer misdraw periodic ones.
 ``PITCH_CURVE``
     Roller followers only (``[dxf].pitch_curve``): the roller-centre path,
-    dashed by its geometry: open LWPOLYLINE dashes (``PITCH_DASH`` mm long,
-    ``PITCH_GAP`` mm apart, stretched to fit the curve's length), each within
-    ``[dxf].chord_tolerance`` of the curve, linetype Continuous. LibreCAD
-    restarts a linetype pattern at every vertex, so a DASHED closed polyline
-    or spline with short segments prints solid; FreeCAD ignores linetypes;
-    and OpenSCAD would extrude a closed pitch polyline as a part 1.8× too
-    large. Dashes print dashed everywhere and close no outline.
+    dashed by its geometry: one open degree-1 SPLINE per dash (``PITCH_DASH``
+    mm long, ``PITCH_GAP`` mm apart, stretched to fit the curve's length),
+    its control points within ``[dxf].chord_tolerance`` of the curve,
+    linetype Continuous. LibreCAD restarts a linetype pattern at every
+    vertex, so a DASHED closed polyline or spline with short segments prints
+    solid; FreeCAD ignores linetypes. Dashes print dashed everywhere, and as
+    SPLINEs OpenSCAD skips them (it closed each open LWPOLYLINE dash into a
+    sliver body, issue 31).
 ``GROOVE_INNER``, ``GROOVE_OUTER``, ``BLANK``
     A groove cam (issue 15) instead of ``CAM_PROFILE``: its inner and outer
     flank as one SPLINE each (their own certified fits), the pitch curve
     being the groove's centre line, and the blank's rim as a CIRCLE. The
     polyline and arcs files hold the same layers.
 ``BORE``
-    The bore as a CIRCLE, or bore and keyway as one closed LWPOLYLINE whose
-    bore arc is an exact bulge.
+    The bore (and keyway) as one closed cubic SPLINE of Bézier spans (triple
+    knots): each arc span ≤ ``BORE_SPAN_DEG`` with the standard handles
+    (4/3)·tan(θ/4)·r, whose radial error is below 1.1e-9 of the radius
+    (Dokken et al. 1990), the keyway's sides straight spans with exact
+    corners. A CIRCLE or a bulge polyline would be read by OpenSCAD (which
+    ignores bulges); as a SPLINE OpenSCAD skips it, so ``profile.dxf`` gives
+    OpenSCAD nothing to extrude, and the part comes from ``profile_poly.dxf``.
 ``CENTER``
     Two centre lines through the cam axis, CENTER linetype.
 ``ANNOTATION``
@@ -55,7 +64,7 @@ LINEs and one ARC with its keyway. The pitch curve, centre lines and text are
 left out of both so a cutter does not cut them.
 
 Every file has ``$EXTMIN``/``$EXTMAX`` and ``$LIMMIN``/``$LIMMAX`` set to
-the drawing's extents and its initial view framed on them (not ezdxf's
+the drawing's extents plus ``EXTENTS_MARGIN`` and its initial view framed on them (not ezdxf's
 ±1e20 and 1000 mm defaults). More closed outlines (a groove's flanks, a
 second plate) go on layers of their own through the same helpers
 (``_add_profile_spline``, ``_add_closed_polyline``, ``_add_arcs``, each
@@ -87,7 +96,7 @@ from ezdxf.document import Drawing
 from ezdxf.layouts import Modelspace
 
 from camcad.errors import ExportError
-from camcad.export._outline import arc_outline, flatten_bspline, flatten_curve
+from camcad.export._outline import arc_outline, chord_budget, flatten_bspline, flatten_curve
 from camcad.export.atomic import atomic_write
 from camcad.export.spec import DxfSpec
 from camcad.fit.curve import BSplineCurve
@@ -123,6 +132,8 @@ PITCH_GAP = 0.75  # mm
 MIN_DASHES = 24  # a small cam still shows a dashed curve
 TEXT_WIDTH = 1.0  # character width / height, a generous bound for the drawing's extents (no font metrics)
 VIEW_MARGIN = 5.0  # mm around the extents in the initial view
+EXTENTS_MARGIN = 5.0  # mm round the drawn box in $EXTMIN/$EXTMAX: a fit-to-page print keeps pen and text
+BORE_SPAN_DEG = 11.25  # largest sweep of one Bézier span of the bore spline (radial error < 1.1e-9 r)
 
 # layer name: (ACI colour, linetype)
 LAYERS: dict[str, tuple[int, str]] = {
@@ -133,7 +144,8 @@ LAYERS: dict[str, tuple[int, str]] = {
     "PITCH_CURVE": (3, "Continuous"),  # dashed by its geometry (see the module docstring)
     "BORE": (1, "Continuous"),
     "CENTER": (4, "CENTER"),
-    "ANNOTATION": (2, "Continuous"),
+    "ANNOTATION": (250, "Continuous"),  # dark grey: prints on white paper (yellow, 2, did not)
+    "FRAME": (8, "Continuous"),  # not plotted: the sheet's margin round profile.dxf (see _frame)
 }
 
 
@@ -165,7 +177,9 @@ def _new_document() -> tuple[Drawing, Modelspace]:
     doc.header["$INSUNITS"] = INSUNITS_MM
     doc.header["$MEASUREMENT"] = MEASUREMENT_METRIC
     for name, (color, linetype) in LAYERS.items():
-        doc.layers.add(name, color=color, linetype=linetype)
+        layer = doc.layers.add(name, color=color, linetype=linetype)
+        if name == "FRAME":
+            layer.dxf.plot = 0
     return doc, doc.modelspace()
 
 
@@ -211,11 +225,51 @@ def _add_closed_polyline(msp: Modelspace, points: np.ndarray, layer: str) -> Non
     )
 
 
+def bore_bezier(bore: BoreOutline) -> np.ndarray:
+    """Control points (3k + 1, 2) [mm] of the bore outline as k cubic Bézier spans, counter-clockwise, closed.
+
+    Arc spans of sweep θ ≤ ``BORE_SPAN_DEG`` have handles of length
+    (4/3)·tan(θ/4)·r along the tangents (Dokken et al. 1990); the radial
+    error grows as θ⁶ (2.7e-4 r at 90°), so below 1.1e-9 r at 11.25°. Keyway sides are
+    straight spans (control points at thirds), corners exact.
+    """
+    r = bore.radius
+    if bore.has_keyway:
+        (x0, y0, _), (x1, y1, _), (x2, y2, _), (x3, y3, _) = bore.bulge_vertices()
+        a0 = math.atan2(y3, x3)
+        sweep = 2.0 * math.pi - 2.0 * math.asin(bore.keyway_width / (2.0 * r))
+        lines = [((x0, y0), (x1, y1)), ((x1, y1), (x2, y2)), ((x2, y2), (x3, y3))]
+    else:
+        a0, sweep, lines = -0.5 * math.pi, 2.0 * math.pi, []
+    pts: list[tuple[float, float]] = []
+    for a, b in lines:
+        pa, pb = np.asarray(a), np.asarray(b)
+        pts += [a, tuple(pa + (pb - pa) / 3.0), tuple(pa + 2.0 * (pb - pa) / 3.0)]
+    n = max(1, math.ceil(math.degrees(sweep) / BORE_SPAN_DEG - 1e-9))
+    theta = sweep / n
+    k = 4.0 / 3.0 * math.tan(theta / 4.0) * r  # Dokken et al. 1990: the cubic arc's handle length
+    for i in range(n):
+        t0, t1 = a0 + i * theta, a0 + (i + 1) * theta
+        p0 = (r * math.cos(t0), r * math.sin(t0))
+        p3 = (r * math.cos(t1), r * math.sin(t1))
+        pts += [
+            p0,
+            (p0[0] - k * math.sin(t0), p0[1] + k * math.cos(t0)),
+            (p3[0] + k * math.sin(t1), p3[1] - k * math.cos(t1)),
+        ]
+    pts.append(pts[0])
+    return np.asarray(pts, dtype=np.float64)
+
+
 def _add_bore_exact(msp: Modelspace, bore: BoreOutline) -> None:
-    if not bore.has_keyway:
-        msp.add_circle((0.0, 0.0), bore.radius, dxfattribs={"layer": "BORE"})
-        return
-    msp.add_lwpolyline(bore.bulge_vertices(), format="xyb", close=True, dxfattribs={"layer": "BORE"})
+    """The bore (and keyway) as one closed cubic SPLINE of Bézier spans (see :func:`bore_bezier`)."""
+    control = bore_bezier(bore)
+    spans = (len(control) - 1) // 3
+    spline = msp.add_spline(degree=3, dxfattribs={"layer": "BORE"})
+    spline.dxf.flags = 0
+    spline.control_points = [(float(x), float(y), 0.0) for x, y in control]  # type: ignore[assignment]
+    knots = [0.0] + [float(j) for j in range(spans + 1) for _ in range(3)] + [float(spans)]
+    spline.knots = knots  # type: ignore[assignment]
 
 
 def _add_arcs(msp: Modelspace, pieces: Pieces, layer: str) -> None:
@@ -283,17 +337,42 @@ def pitch_dashes(points: np.ndarray) -> list[np.ndarray]:
 
 
 def _add_dashes(msp: Modelspace, dashes: list[np.ndarray], layer: str) -> None:
+    """Each dash as an open degree-1 SPLINE through its vertices (clamped, uniform knots)."""
     for dash in dashes:
-        msp.add_lwpolyline([(float(x), float(y)) for x, y in dash], format="xy", dxfattribs={"layer": layer})
+        spline = msp.add_spline(degree=1, dxfattribs={"layer": layer})
+        spline.dxf.flags = 0
+        spline.control_points = [(float(x), float(y), 0.0) for x, y in dash]  # type: ignore[assignment]
+        spline.knots = [0.0, *map(float, range(len(dash))), float(len(dash) - 1)]  # type: ignore[assignment]
 
 
 def _frame(doc: Drawing, box: tuple[float, float, float, float]) -> None:
-    """Set the drawing's extents and limits to ``box`` (xmin, ymin, xmax, ymax) [mm] and frame the view."""
+    """Set extents and limits to ``box`` (xmin, ymin, xmax, ymax) [mm] + ``EXTENTS_MARGIN``; frame the view.
+
+    LibreCAD's ``dxf2pdf -a`` fits the extents to the page: without the
+    margin it clipped the outline's pen and the last text line's descenders.
+    """
     x0, y0, x1, y1 = (float(v) for v in box)
+    x0, y0, x1, y1 = x0 - EXTENTS_MARGIN, y0 - EXTENTS_MARGIN, x1 + EXTENTS_MARGIN, y1 + EXTENTS_MARGIN
     msp = doc.modelspace()  # ezdxf copies the model space layout's extents and limits to the header on save
     msp.reset_extents((x0, y0, 0.0), (x1, y1, 0.0))
     msp.reset_limits((x0, y0), (x1, y1))
     zoom.window(msp, (x0 - VIEW_MARGIN, y0 - VIEW_MARGIN), (x1 + VIEW_MARGIN, y1 + VIEW_MARGIN))
+
+
+def _add_sheet_frame(msp: Modelspace, box: tuple[float, float, float, float]) -> None:
+    """A rectangle ``EXTENTS_MARGIN`` round ``box`` on the non-plotting layer FRAME: a closed degree-1 SPLINE.
+
+    LibreCAD's ``dxf2pdf -a`` fits the drawn entities (not ``$EXTMIN``) to the
+    page: the frame gives the print its margin and is itself not printed;
+    OpenSCAD skips SPLINEs, so it closes no outline there.
+    """
+    x0, y0, x1, y1 = box
+    m = EXTENTS_MARGIN
+    corners = [(x0 - m, y0 - m), (x1 + m, y0 - m), (x1 + m, y1 + m), (x0 - m, y1 + m), (x0 - m, y0 - m)]
+    spline = msp.add_spline(degree=1, dxfattribs={"layer": "FRAME"})
+    spline.dxf.flags = 0
+    spline.control_points = [(float(x), float(y), 0.0) for x, y in corners]  # type: ignore[assignment]
+    spline.knots = [0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 4.0]  # type: ignore[assignment]
 
 
 def _box(points: np.ndarray, bore: BoreOutline | None) -> tuple[float, float, float, float]:
@@ -432,6 +511,7 @@ def profile_document(
         low, widest = _add_annotation(msp, _annotation_lines(cam, plate, _curves(fit, curves)), reach)
         bottom, right = low - TEXT_HEIGHT, max(reach, widest)
     _frame(doc, (-reach, bottom, right, reach))
+    _add_sheet_frame(msp, (-reach, bottom, right, reach))
     return _audited(doc, "profile.dxf")
 
 
@@ -447,14 +527,20 @@ def profile_poly_document(
     """Build the ``profile_poly.dxf`` document: profile (or ``curves``) and bore as bulge-free LWPOLYLINEs.
 
     Each curve is flattened from its fit's clamped spline with a chord error
-    bound of ``[dxf].chord_tolerance``; the bore polygon (and a groove cam's
-    blank) is inscribed in its circle within the same tolerance, with exact
-    keyway corners. ``cam`` is accepted for a uniform signature and not used.
+    bound of ``[dxf].chord_tolerance`` less the fit's certified error
+    (:func:`~camcad.export._outline.chord_budget`), so every vertex and chord
+    lies within ``chord_tolerance`` of the exact curve; the bore polygon (and
+    a groove cam's blank) is inscribed in its exact circle within the
+    tolerance, with exact keyway corners. ``cam`` is accepted for a uniform
+    signature and not used.
     """
     del cam
     doc, msp = _new_document()
     tol = options.chord_tolerance
-    outlines = [flatten_bspline(c.fit.clamped, tol) for c in _curves(fit, curves)]
+    outlines = [
+        flatten_bspline(c.fit.clamped, chord_budget(tol, c.fit.max_error, field="dxf.chord_tolerance"))
+        for c in _curves(fit, curves)
+    ]
     for curve, outline in zip(_curves(fit, curves), outlines, strict=True):
         _add_closed_polyline(msp, outline, curve.layer)
     if blank_radius is not None:

@@ -55,6 +55,7 @@ from camcad.export._outline import (
     analytic_area,
     bspline_area,
     bspline_length,
+    chord_budget,
     flatten_bspline,
     oriented,
     polygon_area,
@@ -141,7 +142,9 @@ class SolidResult:
 
 
 def _cross_section(fit: ProfileFit, plate: Plate, tol: float) -> tuple[list[FloatArray], BoreOutline | None]:
-    outline = oriented(np.asarray(flatten_bspline(fit.clamped, tol)), ccw=True)
+    """The outline (chord error ``tol`` less the fit's error: ``tol`` from the exact profile) and bore."""
+    chord = chord_budget(tol, fit.max_error, field="mesh.chord_tolerance")
+    outline = oriented(np.asarray(flatten_bspline(fit.clamped, chord)), ccw=True)
     contours = [outline]
     bore = plate.bore
     if bore is not None:
@@ -347,7 +350,11 @@ def build_groove_solid(
     blank_contours = [rim]
     if plate.bore is not None:
         blank_contours.append(oriented(np.asarray(plate.bore.polygon(tol)), ccw=False))
-    inner, outer = (oriented(np.asarray(flatten_bspline(f.clamped, tol)), ccw=True) for f in flanks)
+    chords = [chord_budget(tol, f.max_error, field="mesh.chord_tolerance") for f in flanks]
+    inner, outer = (
+        oriented(np.asarray(flatten_bspline(f.clamped, c)), ccw=True)
+        for f, c in zip(flanks, chords, strict=True)
+    )
     groove_contours = [outer, inner[::-1].copy()]
     blank = manifold3d.Manifold.extrude(
         manifold3d.CrossSection(blank_contours, manifold3d.FillRule.Positive), thickness

@@ -22,6 +22,12 @@ its pocket or a conjugate pair's second plate is one more ``Body``, not a
 new writer. Each body is one product (PRODUCT named after the body) whose
 shape is one MANIFOLD_SOLID_BREP in an ADVANCED_BREP_SHAPE_REPRESENTATION.
 
+A conjugate pair's plates are written as ``cam.step`` and ``cam_2.step``,
+their products named "<design> plate 1" and "<design> plate 2", placed as
+mounted on one shaft: plate 1 from z = 0 to t, plate 2 above it from
+z = t + :data:`PAIR_GAP_MM` to 2t + :data:`PAIR_GAP_MM`, so the two files
+inserted into one assembly sit side by side under their own names.
+
 The file is the same bytes for the same bodies: the header's time stamp,
 author, organisation and system are fixed, numbers are written with their
 shortest round-trip digits, and entity numbers are sequential (no random
@@ -47,6 +53,7 @@ if TYPE_CHECKING:
     from camcad.geometry.plate import Plate
 
 __all__ = [
+    "PAIR_GAP_MM",
     "STEP_TIMESTAMP",
     "Body",
     "Outline",
@@ -63,14 +70,26 @@ MAX_NAME_CHARS = 250
 LINE_WIDTH = 80  # physical lines of the exchange structure are folded after a comma beyond this
 SCHEMA = "AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }"  # AP214 IS
 UNCERTAINTY_MM = 1e-7
+PAIR_GAP_MM = 2.0
+"""Axial gap [mm] between a conjugate pair's plates as mounted (plate 2 above plate 1 on the shaft)."""
 
 
-def plate_body(fit: ProfileFit, plate: Plate) -> Body:
-    """The cam plate: the fit's periodic B-spline extruded by the plate thickness, minus bore and keyway."""
+def plate_body(fit: ProfileFit, plate: Plate, *, part: int = 0) -> Body:
+    """The cam plate: the fit's periodic B-spline extruded by the plate thickness, minus bore and keyway.
+
+    ``part`` 1 or 2 is a conjugate pair's first or second plate: named
+    "<design> plate <part>" and, for plate 2, raised by the thickness plus
+    :data:`PAIR_GAP_MM` (as mounted); 0 is a single plate at z = 0, named
+    after the design.
+    """
     if not fit.curve.periodic:
         raise ExportError("cam.step needs the periodic profile of a closed cam (ProfileFit.curve)")
+    if part not in (0, 1, 2):
+        raise ValueError(f"part must be 0 (a single plate), 1 or 2, got {part!r}")
     holes = (plate.bore,) if plate.bore is not None else ()
-    return Body(name=plate.name, prism=Prism(outer=fit.curve, holes=holes, height=plate.thickness))
+    name = f"{plate.name} plate {part}" if part else plate.name
+    z0 = (plate.thickness + PAIR_GAP_MM) if part == 2 else 0.0
+    return Body(name=name, prism=Prism(outer=fit.curve, holes=holes, height=plate.thickness, z0=z0))
 
 
 def groove_body(
@@ -207,6 +226,6 @@ def write_step(path: str | os.PathLike[str], bodies: Sequence[Body]) -> Path:
     return atomic_write(path, lambda tmp: tmp.write_bytes(text.encode("ascii")))
 
 
-def write_cam_step(path: str | os.PathLike[str], *, fit: ProfileFit, plate: Plate) -> Path:
-    """Write ``cam.step``: the plate of :func:`plate_body` as one solid named after the design."""
-    return write_step(path, [plate_body(fit, plate)])
+def write_cam_step(path: str | os.PathLike[str], *, fit: ProfileFit, plate: Plate, part: int = 0) -> Path:
+    """Write ``cam.step``: the plate of :func:`plate_body` as one solid (``part``: a pair's plate 1 or 2)."""
+    return write_step(path, [plate_body(fit, plate, part=part)])

@@ -80,6 +80,8 @@ class Toolpath:
     operation
         ``"profile"`` (a plate's outline, cut through) or ``"groove"`` (a
         groove cam's slot and flank passes, :func:`camcad.toolpath.groove.plan_groove`).
+    clearing_laps
+        A groove's clearing laps between the slot and the flank passes (one per pass and level).
     """
 
     name: str
@@ -96,6 +98,7 @@ class Toolpath:
     contour_arcs: int
     notes: tuple[str, ...] = ()
     operation: str = "profile"
+    clearing_laps: int = 0
 
     @property
     def tool_radius(self) -> float:

@@ -51,6 +51,9 @@ class GcodeSpec:
     """Milling settings. Lengths mm, feeds mm/min, ``start_angle`` rad."""
 
     tool_diameter: float = 6.0
+    choose_tool: bool = (
+        False  # no tool_diameter stated: a groove gets the largest standard end mill that fits
+    )
     tool_number: int = 1
     tolerance: float = 0.005
     dialect: Dialect = Dialect.LINUXCNC

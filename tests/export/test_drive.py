@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 
 import numpy as np
 import pytest
@@ -89,13 +90,49 @@ def test_build_writes_cam_table_csv_read_back(tmp_path):
     assert data.shape == (361, 4)
     prog = MotionProgram.from_segments(design.motion)
     m = prog.evaluate(np.radians(data[:-1, 0]))
-    assert_allclose(data[:-1, 1], m.s, rtol=1e-8, atol=1e-9)  # nine significant digits
+    assert_allclose(data[:-1, 1], m.s, rtol=0.0, atol=5e-10 + 1e-12)  # nine decimals
     # the constant-velocity stretch: 200 mm/s at 60 rpm = 360°/s is 200/360 mm per master degree
     stretch = (data[:, 0] > 121) & (data[:, 0] < 179)
-    assert_allclose(data[stretch, 2], 200 / 360, rtol=1e-8)
+    assert_allclose(data[stretch, 2], 200 / 360, rtol=0.0, atol=5e-10 + 1e-12)
 
 
 def test_no_cam_table_unless_asked(tmp_path):
     result = build(packaging_design(), tmp_path / "out", only=["tables"])
     assert not (tmp_path / "out" / "cam_table.csv").exists()
     assert all(p.name != "cam_table.csv" for p in result.files)
+
+
+CELL = re.compile(r"-?[0-9]+\.[0-9]{9}")
+
+
+def _cam_table_designs():
+    from tests.conftest import SAMPLES
+
+    shipped = [(p.stem, p) for p in SAMPLES if "cam_table_points" in p.read_text(encoding="utf-8")]
+    return [*shipped, ("packaging", None)]
+
+
+@pytest.mark.parametrize(
+    ("name", "path"), _cam_table_designs(), ids=lambda x: x if isinstance(x, str) else ""
+)
+def test_every_cam_table_cell_is_fixed_notation_within_its_decimals(name, path, tmp_path):
+    """Issue 31: no e-notation (``-1.66533454e-15`` before), no ``-0``; every cell within 0.5e-9 of the
+    motion program evaluated here at the master angle (v, a per master degree by the chain rule)."""
+    from camcad.design import load_design
+
+    design = packaging_design(cam_table_points=3600) if path is None else load_design(path)
+    build(design, tmp_path / "out", only=["tables"])
+    with (tmp_path / "out" / "cam_table.csv").open(newline="") as fh:
+        rows = list(csv.reader(fh))
+    cells = [c for row in rows[1:] for c in row]
+    assert cells and all(CELL.fullmatch(c) for c in cells), [c for c in cells if not CELL.fullmatch(c)][:5]
+    assert not any(c.startswith("-") and float(c) == 0.0 for c in cells)
+    data = np.array(rows[1:], dtype=float)
+    n = design.tables.cam_table_points
+    master = np.arange(n + 1) * (360.0 / n)
+    m = MotionProgram.from_segments(design.motion).evaluate(np.radians(master[:-1]))
+    exact = {"master_deg": master[:-1], "slave": m.s, "velocity": m.v * math.pi / 180}
+    exact["acceleration"] = m.a * (math.pi / 180) ** 2
+    for k, head in enumerate(rows[0]):
+        want = next(v for key, v in exact.items() if head.startswith(key))
+        assert_allclose(data[:-1, k], want, rtol=0.0, atol=5e-10 + 1e-12 * np.abs(want).max(), err_msg=head)

@@ -50,7 +50,10 @@ def test_summary_reports_what_was_written():
     text = program.text
     assert text == render_gcode(tp)
     summary = program.summary()
-    assert set(summary) == {"blocks", "arcs", "cutting_length_mm", "cycle_time_s", "max_deviation_mm"}
+    assert set(summary) == {
+        "blocks", "arcs", "cutting_length_mm", "cycle_time_s", "max_deviation_mm",
+        "tool_diameter_mm", "tool_chosen",
+    }  # fmt: skip
     assert summary["blocks"] == count_blocks(text)
     assert summary["arcs"] == sum(1 for line in text.splitlines() if line.startswith(("G2 ", "G3 ")))
     assert 0.0 < summary["max_deviation_mm"] <= design.gcode.tolerance

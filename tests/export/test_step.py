@@ -408,3 +408,34 @@ def test_conjugate_pair_writes_a_step_file_per_plate(tmp_path: Path) -> None:
         shape = read_step(tmp_path / "out" / name)
         expected = (green_area(fit.curve) - bore.area) * design.cam.thickness
         assert volume(shape) == pytest.approx(expected, rel=1e-6)
+
+
+def test_a_conjugate_pair_names_each_plate_and_places_it_as_mounted(tmp_path):
+    """Issue 31: cam.step and cam_2.step carry "<design> plate 1" and "plate 2" (OpenCASCADE's XCAF
+    names) and sit on one shaft without overlapping: plate 1 at z 0 … t, plate 2 at t + gap … 2t + gap
+    (OpenCASCADE's bounding boxes); each is one valid solid."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    from camcad.export.step import PAIR_GAP_MM
+    from camcad.pipeline import build
+
+    design = load_design(ROOT / "samples" / "indexing_conjugate.toml")
+    build(design, tmp_path / "out", only=["step"])
+    t, name = design.cam.thickness, design.cam.name
+    boxes = []
+    for k, file in ((1, "cam.step"), (2, "cam_2.step")):
+        path = tmp_path / "out" / file
+        assert product_names(path) == [f"{name} plate {k}"]
+        shape = read_step(path)
+        assert BRepCheck_Analyzer(shape).IsValid()
+        assert len(shapes_of(shape, TopAbs_SOLID)) == 1
+        box = Bnd_Box()
+        BRepBndLib.AddOptimal_s(shape, box, False, False)
+        boxes.append((box.GetZMin(), box.GetZMax()))
+    z_lo = [b[0] for b in boxes]
+    z_hi = [b[1] for b in boxes]
+    assert z_lo[0] == pytest.approx(0.0, abs=1e-6) and z_hi[0] == pytest.approx(t, abs=1e-6)
+    assert z_lo[1] == pytest.approx(t + PAIR_GAP_MM, abs=1e-6)
+    assert z_hi[1] == pytest.approx(2 * t + PAIR_GAP_MM, abs=1e-6)
+    assert z_lo[1] > z_hi[0]  # no overlap in an assembly

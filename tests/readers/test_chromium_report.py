@@ -100,3 +100,42 @@ def test_print_is_short_with_drawing_and_key_numbers_on_page_one(browser, pages,
     # the tables are not clipped: the joint table's last column (the meaning) is printed in full
     text = subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
     assert "what it means for the machine" in " ".join(text.split())
+
+
+def test_printed_fe_case_table_keeps_words_whole_and_its_last_column(tmp_path):
+    """Issue 31: in print the FE load-case table wrapped "where" one letter per line and clipped its last
+    column, and the "value" header wrapped. Printed by ``chromium --headless --print-to-pdf``, read back
+    by pdftotext: every header word and every word of the "where" cells is whole, the last column's
+    header and every case's value in it are on the page, and page 1 goes on into the plots."""
+    pytest.importorskip("gmsh")
+    pytest.importorskip("skfem")
+    binary = shutil.which("chromium") or shutil.which("chromium-browser")
+    if binary is None or shutil.which("pdftotext") is None:
+        pytest.skip("chromium or pdftotext not installed")
+    from camcad.report_tables import fmt, label, split_unit
+
+    analysis = analyse(load_design(SAMPLES / "fea_plate.toml"), fea=True, toolpath=False)
+    page = write_report(analysis, tmp_path / "report.html")
+    pdf = tmp_path / "report.pdf"
+    run = subprocess.run(
+        [binary, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+         f"--print-to-pdf={pdf}", page.as_uri()],
+        capture_output=True, text=True, timeout=180,
+    )  # fmt: skip
+    assert pdf.is_file(), run.stderr[-2000:]
+    text = subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+    words = set(text.split())
+    cases = analysis.summary()["fea"]["cases"]
+    keys = list(cases[0])
+    for key in keys:  # header words, e.g. "reaction", "moment", "[N·mm]"
+        for word in label(key).split():
+            assert word in words, f"header word {word!r} of {key!r} broken or missing"
+    for case in cases:
+        for word in str(case.get("von_mises_max_where", "")).replace(",", " ").split():
+            assert word in words or f"{word}," in words, word
+        last = fmt(case.get(keys[-1]), split_unit(keys[-1])[1])
+        assert all(part in text for part in last.replace(",", " ").split()), (keys[-1], last)
+    assert "value" in words  # the quantity tables' header, unbroken
+    # page 1 is filled: the first plot follows the key numbers (it left 40 % of the page empty)
+    first = subprocess.run(["pdftotext", "-f", "1", "-l", "1", str(pdf), "-"], capture_output=True, text=True)
+    assert "Follower motion." in first.stdout

@@ -138,7 +138,7 @@ def test_pitch_curve_prints_dashed_in_colour_and_monochrome(built: Built, tmp_pa
 
     if not built.cam.is_roller or not built.design.dxf.pitch_curve:
         pytest.skip("no pitch curve: not a roller follower")
-    dashes = len(ezdxf.readfile(built.dxf).modelspace().query('LWPOLYLINE[layer=="PITCH_CURVE"]'))
+    dashes = len(ezdxf.readfile(built.dxf).modelspace().query('SPLINE[layer=="PITCH_CURVE"]'))
     colour = paths_by_colour(dxf2pdf(built.dxf, tmp_path / "colour"))
     green = colour[GREEN]
     unit_gap = 1.5  # device units: consecutive strokes of one dash share their end point exactly
@@ -183,3 +183,41 @@ def test_dxf2pdf_at_true_scale_centred(built: Built, tmp_path):
     span_drawn = drawn.max(axis=0) - drawn.min(axis=0)
     # whole device units (0.02 mm) and the pen's round caps: measured 0.01–0.05 mm; a 1 % scale error is 1 mm
     assert np.all(np.abs(span_drawn - span_exact) <= 0.08), (span_drawn, span_exact)
+
+
+@pytest.mark.parametrize("sample", ["quintero_vap_b01", "groove_rocker"])
+def test_fit_to_page_print_keeps_the_outline_and_every_note_line_on_the_page(sample, tmp_path):
+    """Issue 31: ``dxf2pdf -a`` cut the outline at the page edge and half the last note line, and the
+    notes printed yellow. Rendered by pdftoppm, the drawing's ink keeps off every page edge, the notes
+    below the cam are as many separate lines of ink as the file has TEXT lines, and no ink is yellow.
+    (LibreCAD draws text as strokes, so pdftotext has no text to read; the raster is the check.)"""
+    import ezdxf
+    from PIL import Image
+
+    from camcad.design import load_design
+    from camcad.pipeline import build
+
+    build(load_design(Path(__file__).resolve().parents[2] / "samples" / f"{sample}.toml"), tmp_path / "out",
+          only=["dxf"])  # fmt: skip
+    pdf = dxf2pdf(tmp_path / "out" / "profile.dxf", tmp_path / "print")
+    ppm = require("pdftoppm")
+    result = run([ppm, "-r", "100", "-png", "-singlefile", str(pdf), "page"], cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    rgb = np.asarray(Image.open(tmp_path / "page.png").convert("RGB")).astype(int)
+    ink = rgb.min(axis=2) < 200
+    rows, cols = np.nonzero(ink)
+    h, w = ink.shape
+    edge = round(2.0 / 25.4 * 100)  # 2 mm at 100 dpi
+    assert rows.min() > edge and rows.max() < h - 1 - edge, (rows.min(), rows.max(), h)
+    assert cols.min() > edge and cols.max() < w - 1 - edge, (cols.min(), cols.max(), w)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    assert not np.any((r > 180) & (g > 180) & (b < 100)), "yellow ink"
+    # the notes: the lowest bands of inked rows, one per TEXT line, the last as tall as the others
+    msp = ezdxf.readfile(tmp_path / "out" / "profile.dxf").modelspace()
+    texts = len(msp.query('TEXT[layer=="ANNOTATION"]'))
+    band = np.concatenate(([False], ink.any(axis=1), [False]))
+    starts, ends = np.flatnonzero(band[1:] & ~band[:-1]), np.flatnonzero(~band[1:] & band[:-1])
+    assert len(starts) >= texts + 1  # the drawing above, then one band per note line
+    heights = (ends - starts)[-texts:]
+    assert heights.max() < 0.05 * h  # text lines, not the drawing
+    assert heights[-1] >= 0.7 * np.median(heights), heights  # the last line is whole

@@ -1,5 +1,5 @@
-"""OpenSCAD extrudes the polyline and arcs DXFs to the expected volume, takes cam.stl into CGAL, and
-finds no closed construction outline in profile.dxf."""
+"""OpenSCAD extrudes the polyline and arcs DXFs to the expected volume and one body, takes cam.stl into
+CGAL, and extrudes nothing from profile.dxf (issue 31: no dash slivers, no bore without its bulge)."""
 
 from __future__ import annotations
 
@@ -160,13 +160,15 @@ def test_linear_extrude_of_the_arcs_dxf_has_the_expected_volume(built: Built, tm
     assert abs(area - built.solid.spline_area) <= 1.01 * built.fit.tolerance * perimeter + 1e-9
 
 
-def test_profile_dxf_gives_openscad_no_construction_outline(built: Built, tmp_path):
-    """OpenSCAD extrudes every closed contour it can read; in profile.dxf that must be at most the bore.
+def bodies(mesh: trimesh.Trimesh) -> int:
+    """Connected components of a mesh (the bodies OpenSCAD made)."""
+    return len(mesh.split(only_watertight=False))
 
-    OpenSCAD ignores SPLINE (the profile) and drops open paths (the pitch-curve dashes,
-    centre lines); what is left is the bore, far smaller than the part, never the pitch
-    curve's 1.8× larger region.
-    """
+
+def test_profile_dxf_gives_openscad_nothing_to_extrude(built: Built, tmp_path):
+    """Issue 31: OpenSCAD closed each open LWPOLYLINE dash of the pitch curve into a sliver (133–195
+    bodies) and read the keyed bore without its bulge. profile.dxf now holds SPLINEs (profile, bore,
+    pitch dashes, the non-plotting frame), LINEs and TEXT only: OpenSCAD makes no body at all."""
     t = built.design.cam.thickness
     dxf = tmp_path / "profile.dxf"
     dxf.write_bytes(built.dxf.read_bytes())
@@ -174,10 +176,19 @@ def test_profile_dxf_gives_openscad_no_construction_outline(built: Built, tmp_pa
     scad = tmp_path / "plate.scad"
     scad.write_text(f'linear_extrude(height = {t!r}) import("{dxf.name}");\n', encoding="utf-8")
     result = run([program, "-o", str(tmp_path / "plate.stl"), str(scad)], cwd=tmp_path)
-    bore = built.design.plate().bore
-    if not (tmp_path / "plate.stl").is_file() or (tmp_path / "plate.stl").stat().st_size == 0:
-        assert bore is None, result.stderr[-3000:]  # nothing closed at all: OpenSCAD refuses an empty object
-        return
+    out = tmp_path / "plate.stl"
+    if out.is_file() and out.stat().st_size > 0:
+        count = bodies(trimesh.load(out, force="mesh"))
+        pytest.fail(f"OpenSCAD extruded {count} bodies from profile.dxf")
+    assert "top level object is empty" in result.stderr, result.stderr[-3000:]
+
+
+def test_polyline_dxf_extrudes_to_one_body_the_cam(built: Built, tmp_path):
+    """profile_poly.dxf: OpenSCAD makes exactly one connected body (the plate, its bore a hole)."""
+    t = built.design.cam.thickness
+    dxf = tmp_path / "profile_poly.dxf"
+    dxf.write_bytes(built.poly_dxf.read_bytes())
+    openscad(f'linear_extrude(height = {t!r}) import("{dxf.name}");\n', tmp_path / "plate.stl")
     mesh = trimesh.load(tmp_path / "plate.stl", force="mesh")
-    assert bore is not None
-    assert abs(mesh.volume) <= bore.area * t * (1.0 + 1e-3)
+    assert bodies(mesh) == 1
+    assert mesh.euler_number == (0 if built.design.cam.bore > 0 else 2)  # a ring (genus 1) or a disc

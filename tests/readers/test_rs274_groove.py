@@ -55,3 +55,28 @@ def test_rs274_runs_the_groove_program_and_its_motion_is_proved_on_the_exact_fla
     )
     for a, b in zip(moves, ours, strict=True):
         assert max(abs(u - v) for u, v in zip(a.end, b.end, strict=True)) <= 1e-4
+
+
+@pytest.mark.parametrize("tool", ["chosen", "D6"])
+def test_rs274_runs_a_groove_built_without_a_gcode_table(tool, tmp_path):
+    """Issue 31: groove_rocker without [gcode] builds; LinuxCNC reads its cam.ngc (the chosen cutter),
+    and a D6 clears the 24.03 mm groove in stepover passes; both motions are proved, the swept tool
+    covering the whole groove."""
+    from dataclasses import replace
+
+    from camcad.cli import main
+    from tests.toolpath.test_groove import no_gcode_design
+
+    path = no_gcode_design(tmp_path)
+    if tool == "D6":
+        path.write_text(path.read_text() + "\n[gcode]\ntool_diameter = 6.0\n")
+    out = tmp_path / "out"
+    assert main(["build", str(path), "-o", str(out), "-q", "--only", "gcode"]) == 0
+    text = (out / "cam.ngc").read_text(encoding="ascii")
+    design = load_design(path)
+    design = replace(design, gcode=replace(design.gcode, tool_diameter=16.0 if tool == "chosen" else 6.0))
+    proc, canon = run_rs274(text, design.gcode.tool_number, tmp_path)
+    assert proc.returncode == 0 and not errors(proc), errors(proc)
+    assert "PROGRAM_END" in canon
+    cam = Cam.from_design(design)
+    assert_proved(prove(parse_canon(canon), cam, design), cam, design)

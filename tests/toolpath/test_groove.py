@@ -14,10 +14,14 @@ module's own code. On it:
 - nowhere below the face does the tool come closer than r_t − tol to either
   flank, nor leave the groove (tool centre within width/2 − r_t + tol of the
   pitch curve);
+- the swept tool clears the whole groove: every point across it (exact
+  offsets from flank to flank) lies within r_t of a tool centre at full
+  depth, however many clearing passes a narrow tool needs (issue 31);
 - the slot reaches −depth and never goes deeper; no rapid below the safe
-  height; the only plunge ends at Z0, above the material; the ramp descends
-  at most ``step_down`` per lap of the centre line (slope bound, and the
-  depths at which it passes its start point);
+  height; a plunge below Z0 only at the centre line's start point once the
+  slot is cut to full depth (the clearing passes step down there); the ramp
+  descends at most ``step_down`` per lap of the centre line (slope bound,
+  and the depths at which it passes its start point);
 - climb milling on both flanks: with the spindle M3, the flank (the
   material) lies on the tool's right (the G41 rule), whatever the code calls
   clockwise.
@@ -29,6 +33,7 @@ import itertools
 import math
 from dataclasses import dataclass, replace
 from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -109,7 +114,8 @@ class Proof:
     inner_right: bool  # the inner flank lies on the tool's right all along its pass
     outer_right: bool
     rapid_low: float  # lowest Z of a rapid's XY travel or end
-    plunge_ends: tuple[float, ...]  # Z where each pure Z descent at feed ends
+    plunge_ends: tuple[float, ...]  # Z where each pure Z descent at feed ends, but in the cut slot
+    groove_reach: float  # largest distance from a point across the groove to the nearest tool centre at depth
 
 
 def _planar(pts: np.ndarray) -> float:
@@ -197,9 +203,16 @@ def prove(moves: list[Move], cam: Cam, design: Design) -> Proof:
     low = min(
         min(m.end[2], m.start[2] if math.dist(m.start[:2], m.end[:2]) > 1e-9 else m.end[2]) for m in rapids
     )
+    first_bottom = next(k for k, m in enumerate(feeds) if abs(m.end[2] - bottom) < 1e-6)
     plunges = tuple(
-        m.end[2] for m in feeds if m.end[2] < m.start[2] and math.dist(m.start[:2], m.end[:2]) <= 1e-9
+        m.end[2]
+        for k, m in enumerate(feeds)
+        if m.end[2] < m.start[2]
+        and math.dist(m.start[:2], m.end[:2]) <= 1e-9
+        and not (k > first_bottom and math.dist(m.end[:2], start) < 1e-3)
     )
+    across = np.vstack([exact(cam, d)[::4] for d in np.linspace(inner_d, outer_d, 41)])
+    groove_reach = float(cKDTree(at_depth).query(across)[0].max())
     return Proof(
         closed=(closed[0], closed[1]),
         inner_band=bands[0],
@@ -216,6 +229,7 @@ def prove(moves: list[Move], cam: Cam, design: Design) -> Proof:
         outer_right=rights[1],
         rapid_low=low,
         plunge_ends=plunges,
+        groove_reach=groove_reach,
     )
 
 
@@ -228,12 +242,13 @@ def assert_proved(p: Proof, cam: Cam, design: Design) -> None:
     for lo, hi in (p.inner_band, p.outer_band):
         assert r - tol <= lo and hi <= r + tol, (lo, hi)
     assert p.inner_reach <= r + tol and p.outer_reach <= r + tol
+    assert p.groove_reach <= r + tol  # no ridge left anywhere across the groove
     assert p.closest >= r - tol
     assert p.off_centre <= half - r + tol
     assert p.deepest == pytest.approx(-depth, abs=1e-9)
     assert p.inner_right and p.outer_right  # climb on both flanks
     assert p.rapid_low >= spec.safe_height - 1e-9
-    assert all(z >= -1e-9 for z in p.plunge_ends)  # the only plunge stops on the face, Z0
+    assert all(z >= -1e-9 for z in p.plunge_ends)  # a plunge into material stops on the face, Z0
     assert p.ramp_slope <= spec.step_down / p.lap_length * 1.001
     assert p.lap_depths[0] == 0.0 and p.lap_depths[-1] == pytest.approx(-depth)
     assert all(0.0 < a - b <= spec.step_down + 1e-9 for a, b in itertools.pairwise(p.lap_depths))
@@ -293,10 +308,11 @@ def test_header_says_what_each_pass_is():
 
 @pytest.mark.parametrize(
     ("diameter", "allowed"),
-    [(24.03, "below 24.0300"), (30.0, "below 24.0300"), (8.0, "above 8.010")],
+    [(24.03, "below 24.0300"), (30.0, "below 24.0300"), (0.1, "above 0.1196")],
 )
 def test_a_tool_that_does_not_fit_is_refused_naming_the_field(diameter, allowed):
-    """Against the groove's width 2 r_f + c = 24.03 mm: a tool as wide or wider, or one a third as wide."""
+    """Against the groove's width 2 r_f + c = 24.03 mm: a tool as wide or wider, or one so small that a
+    side would need over 200 clearing passes (2 x 12.015 / 201 = 0.1196 mm)."""
     design = load_design(SAMPLE)
     design = replace(design, gcode=replace(design.gcode, tool_diameter=diameter))
     with pytest.raises(DesignError) as err:
@@ -343,3 +359,67 @@ def test_pipeline_plans_a_groove_cam_with_the_groove_passes():
     assert analysis.gcode is not None
     assert "inner flank finishing pass" in analysis.gcode.text
     assert "profile finishing pass" not in analysis.gcode.text
+
+
+def without_gcode_table(text: str) -> str:
+    """A design's TOML text with its ``[gcode]`` table (to the next table or the end) left out."""
+    out, skip = [], False
+    for line in text.splitlines():
+        if line.startswith("["):
+            skip = line.strip() == "[gcode]"
+        if not skip:
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def no_gcode_design(tmp_path) -> Path:
+    path = tmp_path / "groove_no_gcode.toml"
+    path.write_text(without_gcode_table(SAMPLE.read_text(encoding="utf-8")), encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("diameter", [6.0])
+def test_a_narrow_tool_clears_the_groove_in_stepover_passes(diameter):
+    """Issue 31: a tool a quarter or a third of the groove's width is not refused; the clearing passes
+    leave no ridge (the swept tool reaches every point across the groove) and their count is the
+    closed form 2 (⌈(w/2 − r_t)/r_t⌉ − 1) per slot level, w = 2 r_f + c."""
+    design = load_design(SAMPLE)
+    design = replace(design, gcode=replace(design.gcode, tool_diameter=diameter))
+    cam, tp = plan(design)
+    assert_proved(prove(parse_gcode(render_gcode(tp)), cam, design), cam, design)
+    half, r = 12.0 + 0.015, diameter / 2.0
+    assert tp.clearing_laps == 2 * (math.ceil((half - r) / r) - 1) * len(tp.levels) > 0
+    assert tp.max_deviation <= design.gcode.tolerance
+
+
+def test_without_a_gcode_table_a_groove_gets_a_standard_cutter_that_fits(tmp_path):
+    """No [gcode]: the default D6 no longer matters; the largest standard end mill ≤ 0.8 × 24.03 mm
+    (the groove's width 2 r_f + c) is D16, said in the header, and the program is proved."""
+    design = load_design(no_gcode_design(tmp_path))
+    assert design.gcode.choose_tool
+    cam, tp = plan(design)
+    assert tp.spec.tool_diameter == 16.0
+    text = render_gcode(tp)
+    assert "D16.000 (radius 8.000), chosen by camcad to fit the groove" in text.replace("[", "(").replace(
+        "]", ")"
+    )
+    used = replace(design, gcode=tp.spec)
+    assert_proved(prove(parse_gcode(text), cam, used), cam, used)
+
+
+def test_check_and_build_work_without_a_gcode_table(tmp_path, capsys):
+    """``camcad check`` plans no toolpath and passes; ``camcad build`` writes cam.ngc with the chosen
+    cutter, and summary.json and the report say it was chosen."""
+    import json
+
+    from camcad.cli import main
+
+    path = no_gcode_design(tmp_path)
+    assert main(["check", str(path)]) == 0
+    assert "all design limits hold" in capsys.readouterr().out
+    out = tmp_path / "out"
+    assert main(["build", str(path), "-o", str(out), "-q", "--only", "gcode,report"]) == 0
+    gcode = json.loads((out / "summary.json").read_text())["gcode"]
+    assert gcode["tool_diameter_mm"] == 16.0 and gcode["tool_chosen"] is True
+    assert "chosen by camcad to fit the groove" in (out / "report.html").read_text(encoding="utf-8")
+    assert "chosen by camcad" in (out / "cam.ngc").read_text(encoding="ascii")

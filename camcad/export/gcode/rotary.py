@@ -194,6 +194,7 @@ def render_rotary_program(toolpath: RotaryToolpath, dialect: Dialect | str | Non
         cutting_length_mm=float(toolpath.contact_length.sum()) * len(toolpath.levels),
         cycle_time_s=toolpath.cycle_time(),
         max_deviation_mm=toolpath.max_deviation,
+        tool_diameter_mm=s.tool_diameter,
         machine=s.machine.value,
         rotary_axis=s.rotary_axis.value,
         cutter=s.cutter.value,

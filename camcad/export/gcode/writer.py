@@ -79,12 +79,15 @@ def _header(tp: Toolpath, dialect: str) -> list[str]:
         f"dialect: {dialect}",
         "units: millimetres [G21], feeds mm/min",
         "origin: G54 X0 Y0 on the cam axis, Z0 on top of the stock",
-        f"tool: T{s.tool_number} flat end mill D{s.tool_diameter:.3f} (radius {s.tool_radius:.3f})",
+        f"tool: T{s.tool_number} flat end mill D{s.tool_diameter:.3f} (radius {s.tool_radius:.3f})"
+        + (", chosen by camcad to fit the groove" if s.choose_tool and tp.operation == "groove" else ""),
         *(
             [
                 f"stock: blank {tp.thickness:.3f} thick, groove cut to Z{-depth:.4f} from the top face",
                 f"tolerance: {s.tolerance:.4f}, measured flank deviation {tp.max_deviation:.4f}",
-                f"passes: slot ramp in {passes} laps + 1 flat lap, 2 flank finishing, {s.direction.value}",
+                f"passes: slot ramp in {passes} laps + 1 flat lap, "
+                + (f"{tp.clearing_laps} clearing laps, " if tp.clearing_laps else "")
+                + f"2 flank finishing, {s.direction.value}",
             ]
             if tp.operation == "groove"
             else [
@@ -200,6 +203,10 @@ class GcodeSummary:
         Estimated run time from feeds and rapids [s].
     max_deviation_mm
         Measured two-way deviation of the finishing contour from the exact offset curve [mm].
+    tool_diameter_mm
+        The cutter's diameter [mm].
+    tool_chosen
+        True when camcad chose the cutter (no ``gcode.tool_diameter`` stated, a groove cam).
     """
 
     blocks: int
@@ -207,6 +214,8 @@ class GcodeSummary:
     cutting_length_mm: float
     cycle_time_s: float
     max_deviation_mm: float
+    tool_diameter_mm: float = 0.0
+    tool_chosen: bool = False
 
     def as_dict(self) -> dict[str, Any]:
         """Plain dict, values rounded for a stable file."""
@@ -227,6 +236,8 @@ def summarize(toolpath: Toolpath, text: str) -> GcodeSummary:
         cutting_length_mm=toolpath.cutting_length(),
         cycle_time_s=time if math.isfinite(time) else 0.0,
         max_deviation_mm=toolpath.max_deviation,
+        tool_diameter_mm=toolpath.spec.tool_diameter,
+        tool_chosen=toolpath.spec.choose_tool and toolpath.operation == "groove",
     )
 
 
