@@ -41,7 +41,7 @@ from camcad.geometry.cam import Cam
 from camcad.geometry.envelope import PointElement, line_envelope, point_envelope
 from camcad.geometry.sensitivity import Mount, Tol, mount_of
 
-__all__ = ["FormError", "MadeMotion", "made_motion"]
+__all__ = ["FormError", "MadeCurve", "MadeMotion", "made_curve", "made_motion"]
 
 FormError = Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
 """e(u), de/du, d²e/du² [mm, mm/rad, mm/rad²]: a normal form error along the cam angle u [rad]."""
@@ -88,8 +88,11 @@ def _turn(v: FloatArray, angle: FloatArray) -> FloatArray:
 
 
 @dataclass(frozen=True, slots=True)
-class _Curve:
-    """The made base curve at parameters u (m,): point, X′, X″, outward normal, 1/ρ (cam frame)."""
+class MadeCurve:
+    """A made curve at parameters u (m,), cam frame: point, X′, X″ [mm/radᵏ], outward normal, 1/ρ [1/mm].
+
+    ``curvature`` is 1/ρ with ρ signed as everywhere (convex > 0).
+    """
 
     x: FloatArray
     d1: FloatArray
@@ -98,8 +101,11 @@ class _Curve:
     curvature: FloatArray
 
 
-def _made_curve(cam: Cam, u: FloatArray, w: FloatArray, form: FormError | None) -> _Curve:
-    """The design's base curve offset by w + e(u) along its normal, exact to X″."""
+def made_curve(cam: Cam, u: FloatArray, w: FloatArray, form: FormError | None) -> MadeCurve:
+    """The design's base curve (a roller's pitch curve, a face's profile) offset by w + e(u), exact to X″.
+
+    ``w`` (m,) [mm] per point; for a roller, w = −r_f gives the profile itself.
+    """
     m = cam.motion(u)
     element = cam.kinematics.element(m)
     if isinstance(element, PointElement):
@@ -121,7 +127,7 @@ def _made_curve(cam: Cam, u: FloatArray, w: FloatArray, form: FormError | None) 
     speed = np.hypot(d1[:, 0], d1[:, 1])
     normal = side[:, None] * _j(d1 / speed[:, None])
     curvature = -side * _cross(d1, d2) / speed**3  # 1/ρ, convex > 0
-    return _Curve(base.point + off[:, None] * n, d1, d2, normal, curvature)
+    return MadeCurve(base.point + off[:, None] * n, d1, d2, normal, curvature)
 
 
 def _as_variants(deltas: Mapping[Tol, ArrayLike]) -> tuple[dict[Tol, FloatArray], tuple[int, ...]]:
@@ -180,13 +186,13 @@ def made_motion(
     angle = sigma * (phi_all - phase)  # the cam's turn: R(σ(φ − δ))
     u = phi_all - phase
     for _ in range(_ITERATIONS):
-        curve = _made_curve(cam, u, w, form)
+        curve = made_curve(cam, u, w, form)
         g, g_u = _condition(mount0, mounts, curve, angle)
         step = np.clip(g / g_u, -_MAX_STEP, _MAX_STEP)
         u = u - step
         if np.all(np.abs(step) < 1e-13):
             break
-    curve = _made_curve(cam, u, w, form)
+    curve = made_curve(cam, u, w, form)
     g, g_u = _condition(mount0, mounts, curve, angle)
     bad = ~(np.abs(g) < 1e-9 * max(1.0, float(np.max(np.abs(g_u))))) | (np.abs(u - phi_all + phase) > 0.5)
     if np.any(bad):
@@ -243,7 +249,7 @@ def _mount_arrays(mount: Mount, d: dict[Tol, FloatArray]) -> _Mounts:
 
 
 def _condition(
-    mount: Mount, mounts: _Mounts, curve: _Curve, angle: FloatArray
+    mount: Mount, mounts: _Mounts, curve: MadeCurve, angle: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
     """g(u) = 0 at the contact, and dg/du (see the module notes)."""
     y = _turn(curve.x, angle)
@@ -264,7 +270,7 @@ def _condition(
 
 
 def _kinematics(
-    mount: Mount, mounts: _Mounts, curve: _Curve, angle: FloatArray, g_u: FloatArray
+    mount: Mount, mounts: _Mounts, curve: MadeCurve, angle: FloatArray, g_u: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """q, dq/dφ, d²q/dφ² [mm or rad] and α [rad] at the converged contact."""
     sigma = mount.sigma
