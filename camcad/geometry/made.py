@@ -172,7 +172,6 @@ def made_motion(
     ph = np.asarray(phi, dtype=float).ravel()
     var, shape = _as_variants(deltas or {})
     nv = int(np.prod(shape)) if shape else 1
-    rows = nv * ph.size
 
     def per_point(tol: Tol) -> FloatArray:
         a = var.get(tol, np.zeros(nv))
@@ -212,7 +211,6 @@ def made_motion(
         pressure_angle=alpha.reshape(out_shape),
         contact=u.reshape(out_shape),
     )
-    del rows
     readonly(out.phi, out.lift, out.velocity, out.acceleration, out.pressure_angle, out.contact)
     return out
 

@@ -142,3 +142,37 @@ def test_a_bad_band_is_named():
     pts, _ = measured()
     with pytest.raises(DesignError, match=r"band: \(0\.01, 0\.02\) mm"):
         inspect_points(CAM, pts, band=(0.01, 0.02))
+
+
+def test_a_profile_that_repeats_itself_is_refused():
+    """Two equal lobes: the turn is ambiguous by 180°, so the fit refuses rather than guess."""
+    from camcad.design import parse_design
+
+    lobe = [
+        {"kind": "rise", "angle": 60.0, "lift": 10.0, "law": "cycloidal"},
+        {"kind": "dwell", "angle": 30.0},
+        {"kind": "return", "angle": 60.0, "lift": 10.0, "law": "cycloidal"},
+        {"kind": "dwell", "angle": 30.0},
+    ]
+    data = {
+        "cam": {"name": "two lobes", "base_radius": 40.0, "thickness": 8.0},
+        "follower": {"type": "translating-roller", "roller_radius": 10.0},
+        "motion": lobe + lobe,
+    }
+    cam = Cam.from_design(parse_design(data))
+    pts = cam.profile(np.linspace(0.0, 2 * np.pi, 720, endpoint=False)).point
+    with pytest.raises(DesignError, match=r"repeats itself"):
+        inspect_points(cam, pts, band=0.02)
+
+
+def test_a_face_follower_cam_on_a_cw_arm():
+    """The fit needs only the exact profile: an oscillating flat-face cam turning cw fits as well."""
+    cam = CAMS["oscillating-flat-cw"]()
+    u = np.linspace(0.0, 2 * np.pi, 720, endpoint=False)
+    prof = cam.profile(u)
+    dev = 0.005 * np.cos(11 * u)
+    pts = _turn(prof.point + dev[:, None] * prof.normal, math.radians(-0.2)) + np.array([0.01, 0.015])
+    ins = inspect_points(cam, pts, band=0.01)
+    assert abs(math.degrees(ins.rotation) + 0.2) < 0.01
+    assert np.hypot(*(ins.centre - [0.01, 0.015])) < 0.001
+    assert ins.passed
