@@ -108,3 +108,15 @@ def test_vectorised_variants_equal_one_by_one():
         one = made_motion(cam, PHI, deltas={k: float(v[i]) for k, v in deltas.items()})
         assert_allclose(many.lift[i], one.lift, rtol=0, atol=1e-12)
         assert_allclose(many.acceleration[i], one.acceleration, rtol=0, atol=1e-9)
+
+
+def test_phase_is_exactly_a_late_motion(any_cam):
+    """Not only to first order: a cam keyed δ late gives s(φ − δ), v(φ − δ), a(φ − δ) exactly."""
+    delta = 0.05
+    made = made_motion(any_cam, PHI, deltas={Tol.PHASE: delta})
+    late = any_cam.motion(PHI - delta)
+    scale = max(1.0, float(np.max(np.abs(late.a))))
+    assert_allclose(made.lift, late.s, atol=1e-10 * scale)
+    assert_allclose(made.velocity, late.v, atol=1e-10 * scale)
+    finite = np.isfinite(made.acceleration)
+    assert_allclose(made.acceleration[finite], late.a[finite], atol=1e-9 * scale)
