@@ -288,8 +288,9 @@ def pressure_angle_identity(mount: Mount, q: ArrayLike, v: ArrayLike) -> FloatAr
     if mount.axis is not None:
         a = np.asarray(mount.axis, dtype=float)
         a_perp = np.array([a[1], -a[0]])
-        if not mount.is_roller:
-            return np.zeros(np.broadcast(qa, va).shape) + 0.0 * qa * va  # type: ignore[no-any-return]
+        if not mount.is_roller:  # a face square to its slide: α ≡ 0 (complex zeros under the complex step)
+            flat: FloatArray = 0.0 * qa * va
+            return flat
         centre = np.asarray(mount.origin) + qa[..., None] * a
         inst = mount.sigma * va[..., None] * a_perp
         n = centre - inst

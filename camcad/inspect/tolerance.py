@@ -85,6 +85,15 @@ class Tolerance:
     distribution: Distribution = Distribution.UNIFORM
 
 
+def _largest(cam: Cam, tol: Tol) -> tuple[float, str]:
+    """The size no tolerance of ``tol`` can reach (a tolerance larger than the part), and its unit."""
+    if tol is Tol.PHASE:
+        return math.pi / 2.0, "rad (a quarter turn)"
+    if tol is Tol.ROLLER_RADIUS:
+        return cam.roller_radius, "mm (the roller radius)"
+    return cam.base_radius, "mm (the base radius)"
+
+
 def _check(cam: Cam, tolerances: Sequence[Tolerance]) -> None:
     allowed = applicable(mount_of(cam))
     for t in tolerances:
@@ -94,6 +103,9 @@ def _check(cam: Cam, tolerances: Sequence[Tolerance]) -> None:
             raise DesignError(field, f"does not apply to this follower; allowed: {names}")
         if not (math.isfinite(t.value) and t.value >= 0.0):
             raise DesignError(field, f"{t.value!r}; allowed: a finite tolerance ≥ 0")
+        limit, unit = _largest(cam, t.tol)
+        if t.value >= limit:
+            raise DesignError(field, f"±{t.value:g} is larger than the part; allowed: below {limit:g} {unit}")
     if len({t.tol for t in tolerances}) != len(tolerances):
         raise DesignError("tolerance", "a quantity is toleranced twice; allowed: one entry each")
 

@@ -85,6 +85,12 @@ def test_bad_tolerances_are_named():
         monte_carlo(cam, [Tolerance(tol=Tol.ROLLER_RADIUS, value=0.01)], samples=10)
     with pytest.raises(DesignError, match=r"tolerance\.form: -0\.1"):
         linear_dwell(cam, [Tolerance(tol=Tol.FORM, value=-0.1)])
+    with pytest.raises(
+        DesignError, match=r"tolerance\.form: ±60 is larger than the part; allowed: below 50 mm"
+    ):
+        linear_dwell(cam, [Tolerance(tol=Tol.FORM, value=60.0)])
+    with pytest.raises(DesignError, match=r"tolerance\.phase: ±2 is larger than the part"):
+        monte_carlo(cam, [Tolerance(tol=Tol.PHASE, value=2.0)], samples=10)
 
 
 def _radial() -> Cam:
