@@ -150,7 +150,7 @@ def made_motion(
     cam
         The design.
     phi
-        (n,) cam angles [rad].
+        (n,) cam angles [rad], the same for every variant, or (V, n): each variant's own.
     deltas
         Errors by :class:`~camcad.geometry.sensitivity.Tol`, each a scalar or an
         array of variants (V,) (lengths mm, ``PHASE`` rad); broadcast together.
@@ -169,15 +169,20 @@ def made_motion(
         so large the follower jumps to another part of the cam).
     """
     mount0 = mount_of(cam)
-    ph = np.asarray(phi, dtype=float).ravel()
     var, shape = _as_variants(deltas or {})
     nv = int(np.prod(shape)) if shape else 1
+    phi_in = np.asarray(phi, dtype=float)
+    own = phi_in.ndim == 2
+    if own and phi_in.shape[0] != nv:
+        raise ValueError(f"phi of shape {phi_in.shape} for {nv} variants; allowed: (n,) or ({nv}, n)")
+    ph = phi_in.reshape(nv, -1) if own else phi_in.ravel()
+    count = ph.shape[-1]
 
     def per_point(tol: Tol) -> FloatArray:
         a = var.get(tol, np.zeros(nv))
-        return np.repeat(a if a.size == nv else np.zeros(nv), ph.size)
+        return np.repeat(a if a.size == nv else np.zeros(nv), count)
 
-    phi_all = np.tile(ph, nv)
+    phi_all = ph.ravel() if own else np.tile(ph, nv)
     phase = per_point(Tol.PHASE)
     w = per_point(Tol.FORM) + (per_point(Tol.ROLLER_RADIUS) if mount0.is_roller else 0.0)
     mounts = _mount_arrays(mount0, {t: per_point(t) for t in Tol})
@@ -202,7 +207,7 @@ def made_motion(
         )
     lift, vel, acc, alpha = _kinematics(mount0, mounts, curve, angle, g_u)
     scale = mount0.lift_scale
-    out_shape = (*shape, ph.size)
+    out_shape = (*shape, count)
     out = MadeMotion(
         phi=ph,
         lift=(lift * scale).reshape(out_shape),

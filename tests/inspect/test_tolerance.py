@@ -51,7 +51,7 @@ def test_monte_carlo_agrees_with_linear_within_sampling_error(name):
     """Small tolerances: MC mean ≈ 0 and σ ≈ the RSS σ, within 4 standard errors of sampling."""
     cam = CAMS[name]()
     n = 1500
-    mc = monte_carlo(cam, SMALL[name], samples=n, seed=7, step=math.radians(10.0))
+    mc = monte_carlo(cam, SMALL[name], samples=n, seed=7, peaks=False)
     lin = linear_dwell(cam, SMALL[name])
     assert mc.dwell_error.shape == (n, dwell_angles(cam).size)
     std = mc.dwell_error.std(axis=0, ddof=1)
@@ -69,14 +69,32 @@ def test_monte_carlo_is_reproducible_and_orders_percentiles():
         assert np.all(np.diff(values) >= 0.0)
 
 
-def test_monte_carlo_peak_acceleration_is_the_made_motions():
-    """One variant's peak |a| is the max of that made cam's re-solved acceleration on the same grid."""
+def test_monte_carlo_peaks_are_the_made_motions_true_extremes():
+    """Each variant's peak |a| and |α| from a 10° grid, refined, equal a dense 0.002° scan of its made cam."""
     cam = CAMS["oscillating-roller"]()
     tols = SMALL["oscillating-roller"]
     mc = monte_carlo(cam, tols, samples=3, seed=5, step=math.radians(10.0))
-    phi = np.union1d(cam.sample_phi(math.radians(10.0)), np.mod(dwell_angles(cam), 2 * np.pi))
-    one = made_motion(cam, phi, deltas={k: float(v[1]) for k, v in mc.deltas.items()})
-    assert mc.peak_acceleration[1] == pytest.approx(np.max(np.abs(one.acceleration)), rel=1e-12)
+    dense = np.linspace(0.0, 2 * np.pi, 180_000, endpoint=False)
+    for i in range(3):
+        one = made_motion(cam, dense, deltas={k: float(v[i]) for k, v in mc.deltas.items()})
+        scan_a = np.max(np.abs(one.acceleration))
+        scan_alpha = np.max(np.abs(one.pressure_angle))
+        assert scan_a - 1e-6 * scan_a <= mc.peak_acceleration[i] <= scan_a + 1e-6 * scan_a
+        assert scan_alpha - 1e-9 <= mc.peak_pressure_angle[i] <= scan_alpha + 1e-7
+    grid = np.union1d(cam.sample_phi(math.radians(10.0)), np.mod(dwell_angles(cam), 2 * np.pi))
+    coarse = made_motion(cam, grid, deltas={k: float(v[0]) for k, v in mc.deltas.items()})
+    assert np.max(np.abs(coarse.acceleration)) < mc.peak_acceleration[0] - 1e-3  # the grid alone misses it
+
+
+def test_monte_carlo_peaks_of_the_design_are_its_true_extremes():
+    """Zero tolerances: every variant is the design, whose peak |a| is the program's true extreme."""
+    from camcad.extremes import maximum
+
+    cam = CAMS["offset-roller-cw"]()
+    mc = monte_carlo(cam, [Tolerance(tol=Tol.FORM, value=0.0)], samples=2, step=math.radians(7.0))
+    joints = [bp.phi for bp in cam.program.breakpoints]
+    true = maximum(lambda phi, side: np.abs(cam.motion(phi, side=side).a), cam.sample_phi(), joints)
+    assert mc.peak_acceleration[0] == pytest.approx(true.value, rel=1e-9)
 
 
 def test_bad_tolerances_are_named():
@@ -131,7 +149,7 @@ def test_rss_allocation_meets_its_confidence_on_made_cams():
     )
     tols = [Tolerance(tol=t, value=alloc.tolerances[t], distribution=Distribution.NORMAL) for t in params]
     n = 4000
-    mc = monte_carlo(cam, tols, samples=n, seed=11, step=math.radians(30.0))
+    mc = monte_carlo(cam, tols, samples=n, seed=11, peaks=False)
     binding = int(np.argmax(alloc.predicted))
     inside = np.mean(np.abs(mc.dwell_error[:, binding]) <= 0.02)
     assert abs(inside - 0.95) < 4 * math.sqrt(0.95 * 0.05 / n)
