@@ -28,7 +28,8 @@ The pressure angle follows from Kennedy's theorem: the common normal passes
 through the cam–follower instant centre I, on the line through the cam axis
 and the follower's centre of rotation (at infinity across a slide), at the
 place the velocities agree. So α = F(q, v, mount) is a closed-form function
-of the lift, the velocity and the mount (Norton 2009, §8.5 for the slide);
+of the lift, the velocity and the mount (for the slide it is Quang & Hung
+2015, eq. 4);
 δα = F_q δq + F_v δv + F_mount δmount, its partial derivatives taken by the
 complex step (F evaluated at a complex argument q + iη: exact to round-off,
 no subtraction; Squire & Trapp 1998).
@@ -36,7 +37,8 @@ no subtraction; Squire & Trapp 1998).
 References
 ----------
 .. [1] Rothbart (2004), Cam Design Handbook, McGraw-Hill, §10.
-.. [2] Norton (2009), Cam Design and Manufacturing Handbook, 2nd ed., Industrial Press.
+.. [2] Quang & Hung (2015), Computer aided cam design of roller-follower cam mechanism
+   (../shared/papers/002_3938fa916e46e710.txt).
 .. [3] Squire & Trapp (1998), Using complex variables to estimate derivatives of real
    functions, SIAM Review 40(1), 110–112. doi:10.1137/S003614459631241X
 """
