@@ -3,7 +3,7 @@
 The layers are those of the README's architecture section, bottom first::
 
     shared bottom (_typing, _version, errors, angles, extremes, findings, roots, units)
-      < motion < geometry < dynamics < fea < fit < toolpath < export
+      < motion < geometry < dynamics < inspect < fea < fit < toolpath < export
       < design
       < analysis, positive, report, report_tables, _plots < pipeline < explore
       < cli, serve, __init__, __main__
@@ -36,6 +36,10 @@ LAYER_ORDER: tuple[frozenset[str], ...] = (
     frozenset({"motion"}),
     frozenset({"geometry"}),
     frozenset({"dynamics"}),
+    # camcad/inspect/ (issue 38): tolerance statistics and inspection of a made cam; it needs the
+    # exact envelope (geometry) and the motion laws, and nothing of fit/toolpath/export, which may
+    # later use it (a compensated profile goes to the fit and the tool path)
+    frozenset({"inspect"}),
     frozenset({"fea"}),  # camcad/fea/ (issue 22): the plate's FE check, from geometry, plate and dynamics
     frozenset({"fit"}),
     frozenset({"toolpath"}),  # camcad/toolpath/ (issue 13): the arc-spline tool paths

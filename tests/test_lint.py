@@ -22,6 +22,7 @@ STRICT_TYPED = (
     "camcad/motion",
     "camcad/geometry",
     "camcad/fit",
+    "camcad/inspect",
     "camcad/extremes.py",
     "camcad/findings.py",
     "camcad/roots.py",
