@@ -343,7 +343,9 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
         if k["stress_allowable"] is not None
         else "no allowable set"
     )
-    force_over = k["force_min"] is not None and k["force_min"] < analysis.design.dynamics.min_contact_force
+    # red exactly when the dynamics reports a jump (the banner's finding): a groove or a conjugate pair drives
+    # the follower both ways, so a negative force there is the other flank or roller driving, not a jump
+    force_over = any(f.kind == "jump" for f in analysis.findings)
     if k["control_points"] is None:
         fit_card = _card("NURBS fit", "not run")
     else:
