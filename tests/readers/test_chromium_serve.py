@@ -403,7 +403,7 @@ def test_family_switch_draws_the_second_plate(browser, tmp_path):
     with _serve(tmp_path, "packaging_rocker") as (url, design):
         _open(browser, url)
         assert not browser.execute_script("return !!document.getElementById('second-plate')")
-        browser.find_element("css selector", "#group-cam details summary").click()  # the keys left at defaults
+        browser.find_element("css selector", "#group-cam details summary").click()  # the keys at defaults
         style = browser.find_element("name", "cam.style")
         _edited(browser, lambda: style.send_keys("conjugate"), "the conjugate pair")
         assert browser.execute_script("return document.body.dataset.state") == "ok"
@@ -465,7 +465,8 @@ def test_tab_reaches_every_control_and_each_has_a_name(browser, served):
         """
         const all = [...document.querySelectorAll('input, select, button, summary, a[href], [tabindex]')];
         const folded = e => e.tagName !== 'SUMMARY' && e.closest('details:not([open])');
-        const shown = all.filter(e => !e.disabled && e.offsetParent !== null && e.tabIndex >= 0 && !folded(e));
+        const shown = all.filter(e => !e.disabled && e.offsetParent !== null && e.tabIndex >= 0
+                                      && !folded(e));
         shown.forEach((e, i) => { if (!e.id) e.id = 'ctl-' + i; });
         const named = e => (e.labels && e.labels.length && e.labels[0].textContent.trim())
           || e.getAttribute('aria-label') || e.textContent.trim();
