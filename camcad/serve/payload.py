@@ -46,8 +46,12 @@ def _xy(points: Any, n: int = _OUTLINE_POINTS) -> list[list[float]]:
 
 def _series(values: Any, index: np.ndarray, clip: float | None = None) -> list[float | None]:
     arr = np.asarray(values, dtype=float)[index]
-    keep = np.isfinite(arr) if clip is None else np.isfinite(arr) & (np.abs(arr) <= clip)
-    return [round(float(v), 6) if k else None for v, k in zip(arr, keep, strict=True)]
+    with np.errstate(invalid="ignore"):
+        keep = np.isfinite(arr) if clip is None else np.isfinite(arr) & (np.abs(arr) <= clip)
+    out: list[float | None] = np.round(np.where(keep, arr, 0.0), 6).tolist()
+    for i in np.flatnonzero(~keep).tolist():  # a gap in the curve (null in the JSON)
+        out[i] = None
+    return out
 
 
 def _followers(analysis: Analysis, reach: float, cam: Any = None) -> list[dict[str, Any]]:
