@@ -149,6 +149,10 @@ body[data-state="invalid"] .card { outline: 2px dashed var(--bad-edge); }
 .u-legend { font-size: 11.5px; }
 .chart .plot { width: 100%; overflow: hidden; }
 #pin-note:empty { display: none; }
+#compare { overflow-x: auto; margin-bottom: 10px; }
+#compare table { font-size: 12.5px; border-collapse: collapse; }
+#compare td, #compare th { padding: 2px 8px; border-bottom: 1px solid var(--line); text-align: right; }
+#compare td:first-child, #compare th:first-child { text-align: left; }
 #pin-note { font-size: 12px; color: #6c5b7b; }
 """
 
@@ -201,6 +205,7 @@ def render_page(
         f'<section class="alert bad" id="notice" role="alert">{_e(notice)}</section>\n'
         '<section class="alert bad" id="general-error" role="alert"></section>\n'
         '<div id="alerts"></div>\n'
+        '<section id="compare" aria-live="polite"></section>\n'
         '<section id="motion-diagram" aria-label="motion diagram: drag a segment boundary on the '
         'displacement chart"></section>\n'
         '<section class="glance"><figure id="cam-drawing"><div id="cam-drawing-svg"></div>'

@@ -438,10 +438,22 @@ def test_invalid_input_marks_everything_out_of_date_and_keeps_the_last_result(br
     assert shown["drawing"] == before  # the last valid cam stays beside the error
 
 
+def load_design_with_radius(path: Path, radius: float):
+    """The design file with cam.base_radius replaced, through the loader."""
+    from camcad.design import parse_design
+
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    data["cam"]["base_radius"] = radius
+    return parse_design(data)
+
+
 def test_compare_overlays_the_pinned_curves(browser, served):
-    url, _ = served
+    url, path = served
     _open(browser, url)
     before = browser.execute_script("return plots.pressure.u.data[1]")
+    pinned_design = analyse(load_design(path), fit=False, toolpath=False)
+    alpha = pinned_design.summary()["geometry"]["pressure_angle_max_deg"]
+    pin_card = f"{float(f'{alpha:.6g}'):g} °"
     browser.find_element("id", "pin").click()
     field = browser.find_element("name", "cam.base_radius")
     field.clear()
@@ -451,6 +463,14 @@ def test_compare_overlays_the_pinned_curves(browser, served):
     pinned = [y for y in data[2] if y is not None]
     assert max(pinned) == pytest.approx(max(y for y in before if y is not None), abs=1e-6)
     assert max(y for y in data[1] if y is not None) < max(pinned)  # a bigger cam: a smaller angle
+    row = browser.execute_script(
+        "return [...document.querySelectorAll("
+        "'#compare-table tr[data-key=\"geometry.pressure_angle_max_deg\"] td')].map(td => td.textContent)"
+    )
+    now = analyse(load_design_with_radius(path, 70.0), fit=False, toolpath=False)
+    assert row[1] == pin_card and float(row[2].split()[0]) == pytest.approx(
+        now.summary()["geometry"]["pressure_angle_max_deg"], rel=1e-5
+    )
     browser.find_element("id", "pin").click()
     assert len(browser.execute_script("return plots.pressure.u.data")) == 2
 

@@ -466,6 +466,7 @@ function render(out) {
   } else {
     alerts.innerHTML = STALE;  // no "No warnings" while invalid: the old banner said nothing about this input
   }
+  compareTable(last);
   document.body.dataset.state = out.ok ? "ok" : "invalid";
   document.body.dataset.everValid = last ? "1" : "0";
 }
@@ -519,10 +520,40 @@ form.addEventListener("change", ev => {
 form.addEventListener("submit", ev => ev.preventDefault());
 
 // ------------------------------------------------------------------ compare: pin the current design
+function unitWords(key) {  // "pressure_angle_max_deg" → ["pressure angle max", "°"] (summary.json's own keys)
+  const units = {deg: "°", mm: "mm", N: "N", Nmm: "N·mm", MPa: "MPa", mm_per_rad: "mm/rad",
+                 mm_per_rad2: "mm/rad²", mm_per_rad3: "mm/rad³", deg_per_rad: "°/rad", deg_per_rad2: "°/rad²",
+                 deg_per_rad3: "°/rad³"};
+  for (const [tail, u] of Object.entries(units).sort((a, b) => b[0].length - a[0].length)) {
+    if (key.endsWith("_" + tail)) return [key.slice(0, -tail.length - 1).replace(/_/g, " "), u];
+  }
+  return [key.replace(/_/g, " "), ""];
+}
+function compareTable(now) {
+  const box = document.getElementById("compare");
+  if (!pinned || !now) { box.replaceChildren(); return; }
+  const table = document.createElement("table"); table.id = "compare-table";
+  const cap = document.createElement("caption"); cap.textContent = "Pinned design against this one";
+  const head = table.createTHead().insertRow();
+  for (const t of ["quantity", "pinned", "now", "change"]) { const th = document.createElement("th"); th.scope = "col"; th.textContent = t; head.append(th); }
+  table.prepend(cap);
+  const body = table.createTBody();
+  for (const part of ["motion", "geometry", "dynamics"]) {
+    const a = pinned.summary[part] || {}, b = now.summary[part] || {};
+    for (const key of Object.keys(b)) {
+      if (typeof b[key] !== "number" || typeof a[key] !== "number" || key.endsWith("_angle_deg")) continue;
+      const [words, unit] = unitWords(key), row = body.insertRow(); row.dataset.key = part + "." + key;
+      const f = v => (+v.toPrecision(6)) + (unit ? " " + unit : "");
+      const d = b[key] - a[key];
+      for (const t of [words, f(a[key]), f(b[key]), (d > 0 ? "+" : "") + (+d.toPrecision(4))]) row.insertCell().textContent = t;
+    }
+  }
+  box.replaceChildren(table);
+}
 const pinButton = document.getElementById("pin");
 pinButton.addEventListener("click", () => {
   if (pinned) { pinned = null; }
-  else if (last) { pinned = {phi: last.phi_deg, charts: last.charts}; }
+  else if (last) { pinned = {phi: last.phi_deg, charts: last.charts, summary: last.summary}; }
   pinButton.setAttribute("aria-pressed", pinned ? "true" : "false");
   pinButton.textContent = pinned ? "Unpin" : "Pin for compare";
   document.getElementById("pin-note").textContent = pinned ? "pinned curves: grey dashed" : "";
@@ -541,8 +572,10 @@ tableFile.addEventListener("change", async () => {
 });
 tableSave.addEventListener("click", async () => {
   if (!upload) return;
+  tableSave.disabled = true;  // one click, one file: choose the next one again
   let out;
   try { out = await answer(await post("/api/table", {values: {}, table: upload})); } catch (err) { out = unreachable(); }
+  upload = null; tableFile.value = "";
   if (!out.saved) { tableErr.textContent = (out.errors || [{message: "not saved"}])[0].message; return; }
   tableErr.textContent = "";
   const old = segments.find(s => s.kind === "table");
