@@ -62,7 +62,10 @@ def browser_latency() -> list[str]:
         return [f"(no browser latency: {err})"]
     from camcad.serve import make_server
 
-    lines = ["| sample | edit → redrawn page [ms] |", "|---|---:|"]
+    lines = [
+        "| sample | edit → redrawn page [ms] | of which the request [ms] | of which drawing [ms] |",
+        "|---|---:|---:|---:|",
+    ]
     try:
         driver.set_window_size(1400, 1000)
         with tempfile.TemporaryDirectory() as tmp:
@@ -78,7 +81,7 @@ def browser_latency() -> list[str]:
                     _wait(
                         driver, "document.body.dataset.state === 'ok' && document.body.dataset.busy === '0'"
                     )
-                    times = []
+                    times, fetches, draws = [], [], []
                     for i in range(REPEATS + 1):
                         rev = driver.execute_script("return +document.body.dataset.revision")
                         driver.execute_script(EDIT, i)
@@ -86,8 +89,14 @@ def browser_latency() -> list[str]:
                             driver,
                             f"+document.body.dataset.revision > {rev} && document.body.dataset.busy === '0'",
                         )
-                        times.append(float(driver.execute_script("return +document.body.dataset.latency")))
-                    lines.append(f"| {path.stem} | {statistics.median(times[1:]):.0f} |")
+                        got = driver.execute_script(
+                            "const d = document.body.dataset; return [+d.latency, +d.fetchMs, +d.drawMs]"
+                        )
+                        times.append(got[0])
+                        fetches.append(got[1])
+                        draws.append(got[2])
+                    cells = [statistics.median(x[1:]) for x in (times, fetches, draws)]
+                    lines.append(f"| {path.stem} | " + " | ".join(f"{c:.0f}" for c in cells) + " |")
                 finally:
                     srv.shutdown()
                     srv.server_close()

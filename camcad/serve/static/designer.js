@@ -499,8 +499,11 @@ async function analyse() {
   let out;
   try { out = await answer(await post("/api/analyse", {values: values()})); } catch (err) { out = unreachable(); }
   if (id !== sent) return;  // a newer change is on its way
+  const answered = performance.now();
   render(out);
   await new Promise(r => requestAnimationFrame(() => r()));
+  document.body.dataset.fetchMs = String(Math.round(answered - started));  // request, analysis, answer
+  document.body.dataset.drawMs = String(Math.round(performance.now() - answered));  // the page redrawn
   drawn = id;
   document.body.dataset.revision = String(id);
   if (since !== null) document.body.dataset.latency = String(Math.round(performance.now() - since));
