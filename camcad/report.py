@@ -363,12 +363,9 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
             and (second.get("hertz_stress_max_MPa") or 0.0) > k["stress_allowable"]
         )
         stress_over = stress_over or over2
-    # a positively driven follower's force changes sign at crossovers: that is no loss of contact
-    force_over = (
-        not analysis.dynamics.positive_drive
-        and k["force_min"] is not None
-        and k["force_min"] < analysis.design.dynamics.min_contact_force
-    )
+    # red exactly when the dynamics reports a jump (the banner's finding): a groove or a conjugate pair drives
+    # the follower both ways, so a negative force there is the other flank or roller driving, not a jump
+    force_over = any(f.kind == "jump" for f in analysis.findings)
     force_value, force_note = f"{_num(k['force_max'], '.3f')} N", f"min {_num(k['force_min'], '.3f')} N"
     if k["flanks"] is not None:  # a groove: the largest load on the flank that drives
         loads = {n: f["contact_force_max_N"] or 0.0 for n, f in k["flanks"].items()}

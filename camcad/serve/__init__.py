@@ -1,13 +1,16 @@
 """The live designer: ``camcad serve DESIGN.toml`` edits a design in the browser.
 
 A local web page shows the design's fields as a form (grouped as in the TOML,
-with the schema's units and ranges) and redraws the cam with its follower,
-the motion curves, pressure angle, curvature and dynamics, the key numbers
-and the warnings on every change (analysis without fit and toolpath). It
+labelled in words with the schema's units and ranges), the motion program as
+an editor (segments added, split, deleted, reordered, dragged on the s/v/a/j
+charts; laws with their parameters; point tables uploaded), and redraws the
+cam with its follower, the motion curves, pressure angle, curvature and
+dynamics, the key numbers and the warnings on every change (analysis without
+fit and toolpath); undo/redo and a pinned design to compare against. It
 saves the TOML and downloads the shop files as a zip. Stack: the standard
-library's HTTP server and one page of plain JavaScript drawing SVG (no web
-framework, no CDN, nothing to install beyond camcad). Modules: ``form``
-(fields from the schema, values back to a design mapping, TOML text),
+library's HTTP server, the page's own JavaScript and the vendored uPlot
+chart library (no web framework, no CDN, nothing to install beyond camcad).
+Modules: ``form`` (fields from the schema, values back to a design mapping, TOML text),
 ``payload`` (the JSON the page draws), ``page`` (HTML, CSS, script),
 ``toml_edit`` (Save: only the changed keys, comments kept), ``app`` (the
 server: loopback only, a per-run token, same-origin POSTs, bounded threads;

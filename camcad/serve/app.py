@@ -29,11 +29,17 @@ handled here (see "Security of camcad serve" in the README):
   atomically with the target's mode, and refuses (409) when the file changed
   on disk since it was loaded or last saved.
 
+- an uploaded point table is written only on the user's click, as a new file
+  with a plain name (letters, digits, ``._-``, ending ``.csv``) in the design
+  file's folder, never over a file the server did not write itself
+  (``O_EXCL``), after the table parser has read it.
+
 Endpoints: ``GET /?token=…`` the page; ``GET /static/designer.js`` and
 ``/static/designer.css``; ``POST /api/analyse`` the form's values →
 :func:`camcad.serve.payload.evaluate`; ``POST /api/save`` writes the design
 file; ``POST /api/build`` builds every shop file (fit and toolpath included)
-and returns them as a zip.
+and returns them as a zip; ``POST /api/table`` ``{"table": {"name", "text"}}``
+writes an uploaded point table beside the design.
 """
 
 from __future__ import annotations
@@ -85,6 +91,7 @@ BACKLOG = 128  # connections the kernel holds before the server accepts them
 TOKEN_HEADER = "X-Camcad-Token"
 _LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
 _LENGTH = re.compile(r"[0-9]{1,12}")
+_TABLE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}\.csv", re.IGNORECASE)
 _CSP = (
     "default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
     "object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'"
@@ -251,6 +258,7 @@ class Designer:
         self.lock = threading.Lock()
         self.loaded = _read_design(self.path)
         self.notice = ""
+        self.written: set[str] = set()  # point tables this server wrote (it may write them again)
         self._validate(self.loaded.data)  # refuse to start on an invalid file: fix it first
 
     def _validate(self, data: Mapping[str, Any]) -> None:
@@ -294,7 +302,12 @@ class Designer:
         base = self.loaded.data
         name = str(base.get("cam", {}).get("name", self.path.stem))
         return render_page(
-            form_groups(base), title=name, stem=self.path.stem, notice=self.notice, revision=self.revision
+            form_groups(base),
+            title=name,
+            stem=self.path.stem,
+            notice=self.notice,
+            revision=self.revision,
+            motion=[t for t in base.get("motion", []) if isinstance(t, Mapping)],
         )
 
     def data(self, values: Mapping[str, Any]) -> dict[str, Any]:
@@ -348,6 +361,53 @@ class Designer:
                 return {"saved": None, "conflict": False, "errors": [{"field": "", "message": message}]}
             self.loaded = _Loaded(text=text, data=tomllib.loads(text), target=loaded.target, stamp=stamp)
         return {"saved": str(self.path), "conflict": False, "errors": [], "revision": stamp[1]}
+
+    def save_table(self, table: Any) -> dict[str, Any]:
+        """Write an uploaded point table ``{"name": "lift.csv", "text": "…"}`` beside the design file.
+
+        The name must be a plain file name ending ``.csv``; the text must read as a point table
+        (:func:`camcad.motion.table.parse_table_text`); an existing file is never replaced unless this
+        server wrote it. Returns ``{"saved": name or None, "rows": n, "errors": [...]}``.
+        """
+        from camcad.motion.table import parse_table_text
+
+        def refused(message: str) -> dict[str, Any]:
+            return {"saved": None, "rows": 0, "errors": [{"field": "table", "message": message}]}
+
+        if not isinstance(table, Mapping):
+            return refused('expected {"name": "lift.csv", "text": "angle_deg,lift_mm\\n…"}')
+        name, text = table.get("name"), table.get("text")
+        if not isinstance(name, str) or not _TABLE_NAME.fullmatch(name):
+            return refused(
+                f"file name {_quote(str(name))[:120]}: allowed: letters, digits, '.', '_', '-', ending .csv"
+            )
+        if not isinstance(text, str) or not text.strip():
+            return refused(f"{_quote(name)}: the file is empty")
+        try:
+            angle, _, _ = parse_table_text(text, where="table")
+        except DesignError as err:
+            return refused(f"{_quote(name)}: {err.message}")
+        target = self.folder / name
+        raw = text.encode("utf-8")
+        with self.lock:
+            try:
+                if name in self.written and target.is_file() and not target.is_symlink():
+                    _write_atomically(target, text)
+                else:
+                    fd = os.open(
+                        target, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o644
+                    )
+                    with os.fdopen(fd, "wb") as file:
+                        file.write(raw)
+            except FileExistsError:
+                return refused(
+                    f"{_quote(name)} already exists in {self.folder}; choose another name (a file the "
+                    "designer did not write is never replaced)"
+                )
+            except OSError as err:
+                return refused(f"cannot write {target}: {err.strerror or err}")
+            self.written.add(name)
+        return {"saved": name, "rows": len(angle), "errors": []}
 
     def _conflict(self, what: str) -> dict[str, Any]:
         message = (
@@ -591,7 +651,7 @@ class _Handler(BaseHTTPRequestHandler):
         if not (self._loopback() and self._token(urlsplit(self.path).query) and self._origin()):
             return
         route = urlsplit(self.path).path
-        if route not in ("/api/analyse", "/api/save", "/api/build"):
+        if route not in ("/api/analyse", "/api/save", "/api/build", "/api/table"):
             self._refuse(HTTPStatus.NOT_FOUND, "not found")
             return
         body = self._body()
@@ -600,6 +660,9 @@ class _Handler(BaseHTTPRequestHandler):
         values, designer = body.get("values", {}), self.server.designer
         if route == "/api/analyse":
             self._json(HTTPStatus.OK, self.server.run(designer.analyse, values))
+        elif route == "/api/table":
+            out = self.server.run(designer.save_table, body.get("table"))
+            self._json(HTTPStatus.OK if out["saved"] else HTTPStatus.UNPROCESSABLE_ENTITY, out)
         elif route == "/api/save":
             out = self.server.run(designer.save, values, body.get("loaded", ""))
             self._json(HTTPStatus.CONFLICT if out["conflict"] else HTTPStatus.OK, out)

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from camcad._plots._base import trace_name
-from camcad._plots.design import CURVATURE_CLIP, bore_outline, follower_drawings
+from camcad._plots.design import CURVATURE_CLIP, _positive_caption, bore_outline, follower_drawings
 from camcad.design import parse_design
 from camcad.errors import CamcadError, DesignError
 from camcad.pipeline import analyse
@@ -46,37 +46,61 @@ def _xy(points: Any, n: int = _OUTLINE_POINTS) -> list[list[float]]:
 
 def _series(values: Any, index: np.ndarray, clip: float | None = None) -> list[float | None]:
     arr = np.asarray(values, dtype=float)[index]
-    keep = np.isfinite(arr) if clip is None else np.isfinite(arr) & (np.abs(arr) <= clip)
-    return [round(float(v), 6) if k else None for v, k in zip(arr, keep, strict=True)]
+    with np.errstate(invalid="ignore"):
+        keep = np.isfinite(arr) if clip is None else np.isfinite(arr) & (np.abs(arr) <= clip)
+    out: list[float | None] = np.round(np.where(keep, arr, 0.0), 6).tolist()
+    for i in np.flatnonzero(~keep).tolist():  # a gap in the curve (null in the JSON)
+        out[i] = None
+    return out
+
+
+def _followers(analysis: Analysis, reach: float, cam: Any = None) -> list[dict[str, Any]]:
+    return [
+        {
+            "phi_deg": d.phi_deg,
+            "body": [_xy(p) for p in d.body],
+            "links": [_xy(p) for p in d.links],
+            "axes": [_xy(p) for p in d.axes],
+            "marks": _xy(d.marks),
+            "label_at": np.round(d.label_at, 4).tolist(),
+        }
+        for d in follower_drawings(analysis, reach, cam=cam)
+    ]
 
 
 def _drawing(analysis: Analysis) -> dict[str, Any]:
+    """The cam to scale: profile (or a groove's blank and flanks), a pair's second plate, followers."""
     cam, geo, spec = analysis.cam, analysis.geometry, analysis.design.cam
     profile = np.asarray(geo.profile.point)
     pitch = np.asarray(geo.pitch.point)
     reach = float(max(np.hypot(*pitch.T).max() + cam.roller_radius, np.hypot(*profile.T).max()))
-    followers = []
-    for d in follower_drawings(analysis, reach):
-        followers.append(
-            {
-                "phi_deg": d.phi_deg,
-                "body": [_xy(p) for p in d.body],
-                "links": [_xy(p) for p in d.links],
-                "axes": [_xy(p) for p in d.axes],
-                "marks": _xy(d.marks),
-                "label_at": np.round(d.label_at, 4).tolist(),
-            }
-        )
+    positive = analysis.positive
+    groove = None
+    if positive.groove is not None and spec.outer_radius is not None:  # as the report draws it
+        g, phi = positive.groove, geo.phi
+        groove = {
+            "outer_radius": spec.outer_radius,
+            "inner": _xy(cam.offset(phi, g.inner_offset).point),
+            "outer": _xy(cam.offset(phi, g.outer_offset).point),
+            "width": g.width,
+        }
+    second = None
+    partner = positive.partner if positive.second_plate else None
+    if partner is not None:
+        outline = np.asarray(partner.profile(geo.phi).point)
+        second = {"profile": _xy(outline), "followers": _followers(analysis, reach, partner)}
     return {
+        "groove": groove,
+        "second": second,
         "profile": _xy(profile),
         "trace": _xy(pitch),
         "base_radius": cam.base_radius,
         "bore": _xy(bore_outline(spec.bore, spec.keyway_width, spec.keyway_depth)) if spec.bore > 0.0 else [],
-        "followers": followers,
+        "followers": _followers(analysis, reach),
         "rotation": cam.rotation.value,
         "caption": f"To scale, cam frame at φ = 0, turning {cam.rotation.value}: the profile (filled), the "
         f"{trace_name(analysis)} (dashed), the base circle r = {cam.base_radius:g} mm (dotted) and "
-        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°.",
+        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°." + _positive_caption(analysis),
         "profile_radius_max": float(np.hypot(*profile.T).max()),
     }
 
@@ -120,7 +144,20 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
         _chart("torque", "Input torque", "N·mm", one("T", dyn.torque), []),
         _chart("stress", "Hertz stress", "MPa", one("σ", dyn.hertz_stress), stress_limits),
     ]
+    points = _table_points(analysis)
+    if points is not None:
+        charts[0]["points"] = points
     return _series(np.degrees(phi), index), charts
+
+
+def _table_points(analysis: Analysis) -> dict[str, list[float]] | None:
+    """A point table's own points (angle [°], lift): the smooth law at each angle plus its residual."""
+    fit = next((getattr(seg.law, "fit", None) for seg in analysis.design.motion), None)
+    if fit is None:
+        return None
+    angle = np.asarray(fit.angle, dtype=float)
+    lift = np.asarray(analysis.cam.motion(angle).s, dtype=float) + np.asarray(fit.residual, dtype=float)
+    return {"phi_deg": np.round(np.degrees(angle), 6).tolist(), "s": np.round(lift, 6).tolist()}
 
 
 def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
@@ -142,6 +179,7 @@ def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
         "drawing": _drawing(analysis),
         "phi_deg": phi_deg,
         "charts": charts,
+        "lift_unit": "°" if analysis.cam.follower.kind.oscillating else "mm",
         "summary": {k: summary[k] for k in ("motion", "geometry", "dynamics") if k in summary},
         "findings": [f.summary() for f in analysis.findings],
     }

@@ -4,7 +4,8 @@ The designer saves by editing the text it loaded with tomlkit (a round-trip
 TOML library): a changed value is replaced where it stands (its trailing
 comment kept), a key cleared in the form is removed, a key set that the file
 did not have is added at the end of its table, a table the design no longer
-has is removed and a new one is appended. Everything else (comments, blank
+has is removed and a new one is appended; ``[[motion]]`` tables added or deleted in
+the designer are appended or removed at the end of the array. Everything else (comments, blank
 lines, key order, the spelling of unchanged numbers) is the file's own text.
 :func:`edit_toml` then reads its answer back with tomllib and refuses to
 return a text that does not hold exactly the new design.
@@ -50,7 +51,9 @@ def edit_toml(text: str, old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
     old
         ``tomllib.loads(text)``.
     new
-        The design mapping to write (same number of ``[[motion]]`` tables).
+        The design mapping to write. An array of tables is edited table by
+        table in order; tables past the old count are appended, those past the
+        new count removed (with the comments inside them).
 
     Raises
     ------
@@ -75,12 +78,16 @@ def edit_toml(text: str, old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
             if name not in old:
                 doc[name] = value
             elif isinstance(value, list) and isinstance(old[name], list):
-                if len(value) != len(old[name]):
-                    raise ValueError(
-                        f"[[{name}]]: {len(old[name])} tables in the file, {len(value)} to write"
-                    )
-                for i, (before, after) in enumerate(zip(old[name], value, strict=True)):
-                    _edit_table(doc[name][i], before, after)
+                tables = doc[name]
+                for i, (before, after) in enumerate(zip(old[name], value, strict=False)):
+                    _edit_table(tables[i], before, after)
+                for _ in range(len(value), len(old[name])):  # segments deleted: drop the last tables
+                    del tables[len(value)]
+                for after in value[len(old[name]) :]:  # segments added: new tables at the end
+                    table = tomlkit.table()
+                    table.update(after)
+                    table.add(tomlkit.nl())
+                    tables.append(table)
             elif isinstance(value, Mapping) and isinstance(old[name], Mapping):
                 _edit_table(doc[name], old[name], value)
             elif not _same(old[name], value):

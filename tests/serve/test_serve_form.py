@@ -141,3 +141,80 @@ def test_build_returns_the_shop_files(server):
     summary = json.loads(zipfile.ZipFile(io.BytesIO(body)).read("summary.json"))
     assert summary["geometry"]["profile_radius_min_mm"] == pytest.approx(45.0)
     assert math.isfinite(summary["fit"]["max_error_mm"])
+
+
+def test_labels_units_and_hints_come_from_the_schema():
+    """Each field's hint is the schema's "allowed" text, its unit the word that text ends with."""
+    from camcad.design.editor_schema import design_json_schema
+
+    schema = design_json_schema()["properties"]
+    data = _data(SAMPLES / "quintero_vap_b01.toml")
+    fields = {f.path: f for g in form_groups(data) for f in (*g.fields, *g.more)}
+    base = fields["cam.base_radius"]
+    assert (base.label, base.unit, base.required) == ("Base radius", "mm", True)
+    assert schema["cam"]["properties"]["base_radius"]["description"] == f"allowed: {base.hint}"
+    assert (fields["cam.max_pressure_angle"].unit, fields["cam.speed_rpm"].label) == ("°", "Speed")
+    assert fields["cam.rotation"].unit == "" and fields["cam.rotation"].choices == ("ccw", "cw")
+    assert all("_" not in f.label for f in fields.values())
+    assert not any(g.title.startswith("motion") for g in form_groups(data))  # the motion is the editor's
+
+
+def test_a_whole_motion_program_from_the_editor():
+    """motion.count rebuilds the tables: order, new segments, law parameters; blends kept only by source."""
+    data = _data(SAMPLES / "quintero_vap_b01.toml")
+    data["motion"][0] = {
+        "kind": "rise",
+        "angle": 150.0,
+        "lift": 30.0,
+        "law": "polynomial",
+        "start": {"a": 0.0},
+    }
+    values = {
+        "motion.count": "4",
+        "motion[0].kind": "dwell", "motion[0].angle": "30",
+        "motion[1].kind": "rise", "motion[1].angle": "120", "motion[1].lift": "30",
+        "motion[1].law": "polynomial", "motion[1].source": "0",
+        "motion[2].kind": "dwell", "motion[2].angle": "90",
+        "motion[3].kind": "return", "motion[3].angle": "120", "motion[3].lift": "close",
+        "motion[3].law": "dudley", "motion[3].degree": "7", "motion[3].source": "0",
+    }  # fmt: skip
+    motion = design_data(data, values)["motion"]
+    assert motion == [
+        {"kind": "dwell", "angle": 30},
+        {"kind": "rise", "angle": 120, "lift": 30, "law": "polynomial", "start": {"a": 0.0}},
+        {"kind": "dwell", "angle": 90},
+        {"kind": "return", "angle": 120, "lift": "close", "law": "dudley", "degree": 7},
+    ]
+    design = parse_design(design_data(data, values))
+    assert [round(math.degrees(s.span), 9) for s in design.motion] == [30, 120, 90, 120]
+    assert design.motion[3].law.describe() == parse_design(
+        {**data, "motion": [{"kind": "rise", "angle": 240, "lift": 30, "law": "dudley", "degree": 7},
+                            {"kind": "return", "angle": 120, "lift": 30, "law": "dudley", "degree": 7}]}
+    ).motion[1].law.describe()  # fmt: skip
+
+
+def test_a_table_upload_writes_only_new_plain_files_beside_the_design(server):
+    srv, design = server
+    folder = design.parent
+    text = (SAMPLES / "measured_lift.csv").read_text(encoding="utf-8")
+
+    def upload(name, body=text):
+        status, _, answer = _request(srv, "POST", "/api/table", {"table": {"name": name, "text": body}})
+        return status, json.loads(answer)
+
+    status, out = upload("gauge.csv")
+    assert status == 200 and out["saved"] == "gauge.csv" and out["rows"] == 360
+    assert (folder / "gauge.csv").read_text(encoding="utf-8") == text
+    assert upload("gauge.csv")[0] == 200  # its own file: written again
+    (folder / "mine.csv").write_text("kept\n", encoding="utf-8")
+    status, out = upload("mine.csv")
+    assert status == 422 and "already exists" in out["errors"][0]["message"]
+    assert (folder / "mine.csv").read_text(encoding="utf-8") == "kept\n"
+    (folder / "link.csv").symlink_to(folder / "mine.csv")
+    assert upload("link.csv")[0] == 422 and (folder / "mine.csv").read_text(encoding="utf-8") == "kept\n"
+    for name in ("../out.csv", "/tmp/x.csv", "a/b.csv", ".hidden.csv", "x.txt", "x.csv\n"):
+        status, out = upload(name)
+        assert status == 422 and "allowed" in out["errors"][0]["message"], name
+    assert not (folder.parent / "out.csv").exists()
+    status, out = upload("bad.csv", "angle,lift\n0,abc\n")
+    assert status == 422 and not (folder / "bad.csv").exists()

@@ -8,7 +8,6 @@ import re
 import sys
 from pathlib import Path
 
-import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -96,8 +95,15 @@ def test_unchanged_numbers_keep_their_spelling():
     assert edit_toml(TEXT, OLD, new) == TEXT
 
 
-def test_a_different_number_of_motion_tables_is_refused():
-    new = copy.deepcopy(OLD)
-    new["motion"].append({"kind": "dwell", "angle": 10.0})
-    with pytest.raises(ValueError, match="motion"):
-        edit_toml(TEXT, OLD, new)
+def test_motion_tables_added_and_deleted_read_back():
+    """A segment added is a new [[motion]] table at the end, one deleted is gone; the rest as it was."""
+    longer = copy.deepcopy(OLD)
+    longer["motion"].append({"kind": "dwell", "angle": 10.0, "start": {"v": 0.0}})
+    out = edit_toml(TEXT, OLD, longer)
+    assert tomllib.loads(out) == longer
+    assert out.startswith(TEXT.split("[[motion]]")[0])  # everything before the motion untouched
+    shorter = copy.deepcopy(OLD)
+    del shorter["motion"][-1]
+    out = edit_toml(TEXT, OLD, shorter)
+    assert tomllib.loads(out) == shorter
+    assert out.count("[[motion]]") == len(OLD["motion"]) - 1
