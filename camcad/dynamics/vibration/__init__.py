@@ -7,6 +7,7 @@ spring-loaded follower leaves the cam; :mod:`~camcad.dynamics.vibration.polydyne
 makes the cam whose output follows the program exactly at one speed.
 """
 
+from camcad.dynamics.vibration.analysis import VibrationResult, analyse_vibration
 from camcad.dynamics.vibration.harmonics import acceleration_harmonics, resonances
 from camcad.dynamics.vibration.polydyne import CompensatedMotion, compensate
 from camcad.dynamics.vibration.response import (
@@ -32,8 +33,10 @@ __all__ = [
     "Train",
     "TrainModel",
     "TrainResponse",
+    "VibrationResult",
     "VibrationSpec",
     "acceleration_harmonics",
+    "analyse_vibration",
     "compensate",
     "dwells",
     "periodic_with_flight",

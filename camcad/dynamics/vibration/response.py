@@ -83,7 +83,8 @@ class TrainResponse:
     residuals
         Residual vibration amplitude [lift unit] of the output at the start
         of every dwell (:func:`dwells`), the sum of its modal amplitudes
-        about the dwell's rest position.
+        about the dwell's rest position (that of the lift at the dwell's end:
+        the lift of a damped polydyne cam settles within the dwell).
     leaves
         Whether a spring-loaded follower leaves the cam.
     flights
@@ -141,7 +142,8 @@ def _residuals(train: Train, grid: Grid, states: FloatArray, program: Lift) -> F
     dof = train.dof
     for d, dw in enumerate(spans):
         i = int(np.argmin(np.abs(grid.phi - dw.start % TWO_PI)))
-        s = float(program.evaluate(np.array([dw.start]), side="right").s[0]) * train.unit
+        # the rest position at the dwell's end: a damped polydyne lift still settles early in the dwell
+        s = float(program.evaluate(np.array([dw.end]), side="left").s[0]) * train.unit
         q_eq = _equilibrium(train, s)
         dz = states[:, i].copy()
         dz[:, :dof] -= q_eq
@@ -218,9 +220,10 @@ def train_response(
 
     def exact(p: FloatArray, side: Side) -> tuple[FloatArray, FloatArray]:
         m = program.evaluate(p, side=side)
+        ys = aim.evaluate(p, side=side).s
         zz = propagate(grid, train_system(train), omega, states, np.mod(p, TWO_PI))
         return np.asarray(m.s), np.vstack(
-            ((zz[:, train.dof - 1] / u - m.s), _force(train, m.s, m.v, omega, zz))
+            ((zz[:, train.dof - 1] / u - ys), _force(train, m.s, m.v, omega, zz))
         )
 
     def rows(p: FloatArray, side: Side) -> FloatArray:

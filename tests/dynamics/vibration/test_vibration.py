@@ -483,3 +483,49 @@ def test_bad_input_names_the_field(spec, field):
     with pytest.raises(DesignError) as err:
         spec.validate(arm=False)
     assert err.value.path == field
+
+
+# ------------------------------------------------------------ the analysis entry point
+
+
+def test_speed_map_of_a_compensated_cam_has_its_tuned_minimum():
+    """The issue: the speed map of a compensated cam shows the tuned minimum at N rpm."""
+    from camcad.dynamics.vibration import analyse_vibration
+
+    program = dudley_program()
+    vib = VibrationSpec(stiffness=300.0, damping_ratio=0.05, compensate_rpm=900.0, speed_points=41)
+    dyn = DynamicsSpec(follower_mass=0.8, spring_rate=10.0, spring_preload=600.0)  # keeps contact at 900 rpm
+    result = analyse_vibration(program, vib, dyn, speed_rpm=900.0)
+    sm = result.speed_map
+    k = int(np.argmin(sm.error_peak))
+    assert sm.speeds_rpm[k] == pytest.approx(900.0)
+    assert sm.error_peak[k] < 1e-8 * program.lift
+    assert np.all(sm.residuals[k] < 1e-8 * program.lift)
+    assert abs(result.response.error_peak.value) < 1e-8 * program.lift
+    summary = result.summary()
+    assert summary["compensate_rpm"] == 900.0 and summary["lift_correction_max_mm"] > 0.1
+    rows = result.speed_map_rows()
+    assert rows[0][0] == "speed_rpm" and len(rows) == 42
+    assert result.response_rows()[0] == ("angle_deg", "s_mm", "x_mm", "error_mm", "contact_force")
+
+
+def test_findings_leaves_the_cam_hard_and_residual_soft():
+    from camcad.dynamics.vibration import analyse_vibration
+    from camcad.findings import Severity
+
+    program = rdrd(Cycloidal(), 80 * DEG)
+    vib = VibrationSpec(stiffness=300.0, damping_ratio=0.3, max_residual=1e-6, speed_points=5)
+    dyn = DynamicsSpec(follower_mass=0.5, spring_rate=2.0, spring_preload=170.0 - 0.5 * G)
+    result = analyse_vibration(program, vib, dyn, speed_rpm=900.0)
+    kinds = {f.kind: f for f in result.findings}
+    assert kinds["leaves the cam"].severity is Severity.HARD
+    assert kinds["residual vibration"].severity is Severity.SOFT
+    with pytest.raises(DesignError) as err:
+        analyse_vibration(
+            dudley_program(),
+            VibrationSpec(stiffness=300.0, compensate_rpm=900.0),
+            dyn,
+            speed_rpm=900.0,
+            spring_loaded=False,
+        )
+    assert err.value.path == "vibration.compensate_rpm"
