@@ -279,15 +279,17 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     from camcad.explore.files import write_optimize
     from camcad.explore.measures import measure, parse_limit
     from camcad.explore.optimize import Problem, optimize
-    from camcad.explore.space import parse_variable
+    from camcad.explore.space import check_distinct, parse_variable
 
     data = _design_mapping(args.design)
+    variables = tuple(
+        parse_variable(v, data, flag="--vary", counted=False, source=args.design) for v in args.vary
+    )
+    check_distinct(variables, data, flag="--vary")
     problem = Problem(
         data=data,
         source=args.design,
-        variables=tuple(
-            parse_variable(v, data, flag="--vary", counted=False, source=args.design) for v in args.vary
-        ),
+        variables=variables,
         objectives=tuple(measure(m.strip(), "--minimize") for m in ",".join(args.minimize).split(",")),
         limits=tuple(parse_limit(text) for text in args.limit),
         method=args.method,
@@ -324,9 +326,10 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from camcad.errors import UsageError
     from camcad.explore.measures import measure, parse_limit
-    from camcad.explore.space import grid_points, lhs_points, parse_variable
+    from camcad.explore.space import check_distinct, check_seed, grid_points, lhs_points, parse_variable
     from camcad.explore.sweep import SweepPlan, sweep
 
+    check_seed(args.seed)
     data = _design_mapping(args.design)
     counted = args.samples is None
     variables = tuple(
@@ -334,6 +337,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     )
     if not variables:
         raise UsageError("--grid", "give at least one, e.g. --grid base_radius=30:80:51")
+    check_distinct(variables, data, flag="--grid")
     names = [m.strip() for m in args.pareto.split(",")]
     if len(names) != 2:
         raise UsageError("--pareto", f"{args.pareto!r}: name two quantities, e.g. base_radius,contact_stress")

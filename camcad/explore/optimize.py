@@ -49,6 +49,9 @@ from camcad.explore.space import Variable, apply_values, design_with
 
 __all__ = [
     "ACTIVE",
+    "MAX_COMBINATIONS",
+    "MAX_FRONT_POINTS",
+    "MAX_STARTS",
     "METHODS",
     "RESERVE",
     "Candidate",
@@ -64,6 +67,12 @@ RESERVE = 1e-7
 """Relative margin the solver must keep from every limit (so the optimum passes ``camcad check``)."""
 ACTIVE = 1e-4
 """A constraint whose relative margin is below this is reported active."""
+MAX_STARTS = 1000
+"""Most local searches (``--starts``) per combination of the discrete choices."""
+MAX_FRONT_POINTS = 200
+"""Most points of a two-objective front (``--points``)."""
+MAX_COMBINATIONS = 1000
+"""Most combinations of the discrete choices (``--vary name=a,b,…``), each a full optimisation."""
 _INVALID = -10.0  # the relative margin of every constraint at a design that cannot be analysed
 _FD_STEP = 1e-7  # finite-difference step on the variables scaled to [0, 1]
 _EDGE_STEP = 1e-5  # scaled step that probes whether an optimum sits on the edge of the valid designs
@@ -511,12 +520,21 @@ def optimize(problem: Problem, *, progress: Callable[[str], None] | None = None)
         raise UsageError("--minimize", "give one objective, or two different ones for a Pareto front")
     if not problem.variables:
         raise UsageError("--vary", "give at least one variable, e.g. --vary base_radius=20:120")
-    if problem.starts < 1:
-        raise UsageError("--starts", f"{problem.starts} is not allowed (allowed: 1 or more)")
-    if len(problem.objectives) == 2 and problem.points < 2:
-        raise UsageError("--points", f"{problem.points} is not allowed (allowed: 2 or more)")
+    if not 1 <= problem.starts <= MAX_STARTS:
+        raise UsageError("--starts", f"{problem.starts} is not allowed (allowed: 1 to {MAX_STARTS})")
+    if problem.points > MAX_FRONT_POINTS or (len(problem.objectives) == 2 and problem.points < 2):
+        raise UsageError("--points", f"{problem.points} is not allowed (allowed: 2 to {MAX_FRONT_POINTS})")
+    if not 0 <= problem.seed <= 2**32 - 1:
+        raise UsageError("--seed", f"{problem.seed} is not allowed (allowed: 0 to {2**32 - 1})")
     limits = design_limits(problem.data, problem.limits, source=problem.source)
     discrete = [v for v in problem.variables if not v.continuous]
+    count = math.prod(len(v.choices or ()) for v in discrete)
+    if count > MAX_COMBINATIONS:
+        raise UsageError(
+            "--vary",
+            f"{count} combinations of the choices; allowed: at most {MAX_COMBINATIONS} "
+            "(each is a full optimisation: list fewer choices, or make a variable a range low:high)",
+        )
     combos = list(itertools.product(*(v.choices or () for v in discrete)))
     tried: list[Candidate] = []
     everything: list[Candidate] = []

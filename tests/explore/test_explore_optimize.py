@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 
 import numpy as np
 import pytest
@@ -262,13 +263,41 @@ def test_cli_writes_a_design_file_that_passes_check(tmp_path, capsys):
         (["--vary", "law=cycloidal,warp-drive"], "--vary"),
         (["--vary", "base_radius=20:120", "--limit", "stress<=5"], "--limit"),
         (["--vary", "base_radius=20:120", "--method", "newton"], "--method"),
+        (["--vary", "base_radius=20:120", "--starts", "100000000"], "--starts"),
+        (["--vary", "base_radius=20:120", "--points", "100000000"], "--points"),
+        (["--vary", "base_radius=20:120", "--vary", "cam.base_radius=30:40"], "--vary"),
+        (["--vary", "base_radius=20:120", "--vary", "base_radius=30:40"], "--vary"),
+        (["--vary", "law=cycloidal", "--vary", "motion[0].law=harmonic"], "--vary"),
+        (["--vary", "base_radius=" + ",".join(f"{20 + i / 1000}" for i in range(10_000))], "--vary"),
+        (
+            ["--vary", "law=cycloidal,harmonic", "--vary", "offset=" + ",".join(map(str, range(600)))],
+            "--vary",
+        ),
     ],
-    ids=["unknown-key", "negative", "reversed", "count", "no-segment", "unknown-law", "limit", "method"],
+    ids=[
+        "unknown-key",
+        "negative",
+        "reversed",
+        "count",
+        "no-segment",
+        "unknown-law",
+        "limit",
+        "method",
+        "starts-cap",
+        "points-cap",
+        "same-key-alias",
+        "same-key-twice",
+        "same-segment-law",
+        "10000-choices",
+        "1200-combinations",
+    ],
 )
 def test_bad_options_exit_2_naming_the_flag(args, flag, tmp_path, capsys):
     sample = str(ROOT / "samples" / "offset_roller.toml")
+    start = time.monotonic()
     code = main(["optimize", sample, "--minimize", "base_radius", *args, "-o", str(tmp_path / "o")])
     err = capsys.readouterr().err
+    assert time.monotonic() - start < 30  # refused up front, not after a run
     assert code == 2
     assert err.startswith(f"camcad: error: {flag}:"), err
     assert not (tmp_path / "o").exists()

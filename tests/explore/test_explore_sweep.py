@@ -271,8 +271,27 @@ def test_cli_sweep_grid_and_latin_hypercube(tmp_path, capsys):
         (["--grid", "base_radius=40:80:3", "--jobs", "0"], "--jobs"),
         (["--grid", "base_radius=40:80:3", "--limit", "torque<3000"], "--limit"),
         ([], "--grid"),
+        (["--grid", "base_radius=40:80:3", "--seed", "-1"], "--seed"),
+        (["--grid", "base_radius=40:80", "--samples", "3", "--seed", str(2**32)], "--seed"),
+        (["--grid", "base_radius=40:80:3", "--grid", "cam.base_radius=50:60:2"], "--grid"),
+        (["--grid", "offset=0:5:2", "--grid", "offset=1,2"], "--grid"),
+        (["--grid", "base_radius=" + ",".join(f"{40 + i / 1000}" for i in range(10_000))], "--grid"),
     ],
-    ids=["no-count", "unknown-key", "bad-range", "format", "pareto", "jobs", "limit", "no-grid"],
+    ids=[
+        "no-count",
+        "unknown-key",
+        "bad-range",
+        "format",
+        "pareto",
+        "jobs",
+        "limit",
+        "no-grid",
+        "negative-seed",
+        "seed-beyond-32-bits",
+        "same-key-alias",
+        "same-key-twice",
+        "10000-choices",
+    ],
 )
 def test_bad_options_exit_2_naming_the_flag(args, flag, tmp_path, capsys):
     code = main(["sweep", SAMPLE, *args, "-o", str(tmp_path / "o")])
