@@ -33,6 +33,7 @@ from camcad.errors import (
     CamcadError,
     DesignLimitError,
     exit_code,
+    printable,
 )
 
 if TYPE_CHECKING:
@@ -45,7 +46,7 @@ class _Parser(argparse.ArgumentParser):
     """An argument parser that exits 2 with one clear line (argparse's own code for usage errors)."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(EXIT_INVALID, f"camcad: error: {message} (see '{self.prog} --help')\n")
+        self.exit(EXIT_INVALID, f"camcad: error: {printable(message)} (see '{self.prog} --help')\n")
 
 
 def _progress(quiet: bool) -> Progress | None:
@@ -595,16 +596,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         _silence_stdout()
         return EXIT_PIPE_CLOSED
     except DesignLimitError as err:
-        print(f"camcad: design limit: {err}", file=sys.stderr)
+        _say("design limit", str(err))
         return exit_code(err)
     except CamcadError as err:
-        print(f"camcad: error: {err}", file=sys.stderr)
+        _say("error", str(err))
         return exit_code(err)
     except OSError as err:
-        where = f": {err.filename}" if err.filename else ""
-        print(f"camcad: error: {err.strerror or err}{where}", file=sys.stderr)
+        where = f": {os.fsdecode(err.filename)}" if err.filename else ""
+        _say("error", f"{err.strerror or err}{where}")
         return exit_code(err)
     except Exception as err:  # the one place that maps surprises to exit 1
-        print(f"camcad: unexpected error: {type(err).__name__}: {err}", file=sys.stderr)
+        _say("unexpected error", f"{type(err).__name__}: {err}")
         print("camcad: please report this with your design file", file=sys.stderr)
         return EXIT_UNEXPECTED
+
+
+def _say(kind: str, message: str) -> None:
+    """Print ``camcad: <kind>: <message>`` as one line on stderr: every user string in it escaped."""
+    print(f"camcad: {kind}: {printable(message)}", file=sys.stderr)
