@@ -17,11 +17,12 @@ import signal
 import sys
 import threading
 from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from types import FrameType
 from typing import TYPE_CHECKING, Any
 
+from camcad import _exit_interrupted
 from camcad._version import __version__
 from camcad.errors import (
     EXIT_INTERRUPTED,
@@ -582,9 +583,56 @@ def _no_library_logging() -> Iterator[None]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the camcad command line and return the exit code."""
-    args = build_parser().parse_args(argv)
+    """Run the command line and return the exit code.
+
+    Ctrl-C (SIGINT, and SIGTERM, SIGHUP) at any moment gives one line,
+    ``camcad: interrupted``, and exit 130: while a command runs it raises
+    ``KeyboardInterrupt``, which cleans up (a staged output folder is
+    removed); when this function is the process's entry point (the
+    ``camcad`` command, ``python -m camcad``), a signal after it returns ends
+    the process the same way. The heavy modules are imported by the command
+    after the handling is in place.
+    """
+    entry = _is_entry_point()
+    previous: Any = None
+    code = EXIT_INTERRUPTED
     try:
+        if threading.current_thread() is threading.main_thread():
+            previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+        try:
+            code = _run(argv)
+        except KeyboardInterrupt:  # a signal while an error line was printed
+            print("camcad: interrupted", file=sys.stderr)
+    except KeyboardInterrupt:  # the moment the handling was put in place
+        print("camcad: interrupted", file=sys.stderr)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, _exit_interrupted if entry else previous)
+    if entry and code == EXIT_INTERRUPTED:
+        # CPython 3.11 remembers an interrupt that went through exec() of a string (dataclasses,
+        # namedtuple) and then ends the process by SIGINT at exit, though camcad handled it; the
+        # clean-up has run, so leave now with the documented code
+        with suppress(OSError, ValueError):
+            sys.stdout.flush()
+        with suppress(OSError, ValueError):
+            sys.stderr.flush()
+        os._exit(EXIT_INTERRUPTED)
+    return code
+
+
+def _is_entry_point() -> bool:
+    """Whether :func:`main` runs as the process's command (so a later SIGINT may end the process at once)."""
+    main_module = sys.modules.get("__main__")
+    spec = getattr(main_module, "__spec__", None)
+    if spec is not None and spec.name == "camcad.__main__":  # python -m camcad
+        return True
+    return os.path.basename(sys.argv[0] if sys.argv else "") in ("camcad", "camcad.exe")  # the command
+
+
+def _run(argv: Sequence[str] | None) -> int:
+    """Parse, run the command, and map its errors to one line and an exit code."""
+    try:
+        args = build_parser().parse_args(argv)
         with _terminate_like_interrupt(), _no_library_logging():
             code = int(args.handler(args))
             sys.stdout.flush()

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from camcad.cli import main
-from tests.cli.test_environment import HARMONIC, camcad_cli, environment, tree
+from tests.cli.test_environment import HARMONIC, environment, tree
 from tests.conftest import ROOT
 
 TABLE_DESIGN = """
@@ -37,6 +37,15 @@ law = "table"
 file = {file}
 noise = 0.005
 """
+
+
+@pytest.fixture
+def outdir(tmp_path: Path) -> Path:
+    """``tmp/out`` holding a file of an earlier build."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text('{"old": true}\n')
+    return out
 
 
 # --------------------------------------------------------------------------- one line per error
@@ -67,3 +76,87 @@ def test_a_control_character_in_a_design_path_is_escaped(tmp_path, capsys):
     assert code == 2
     assert len(lines) == 1 and lines[0].startswith("camcad: error: "), lines
     assert "gone\\ncamcad: error: forged.toml" in lines[0]
+
+
+# --------------------------------------------------------------------------- a full disk
+
+
+@pytest.mark.parametrize("forked", [True, False], ids=["report-forked", "report-in-process"])
+def test_a_disk_that_fills_while_the_report_is_written_names_report_html(
+    forked, tmp_path, outdir, capsys, monkeypatch
+):
+    """ENOSPC when report.html is flushed: exit 2 naming OUTDIR/report.html, OUTDIR as it was."""
+    import camcad.pipeline as pipeline
+
+    real_fsync = os.fsync
+
+    def fsync(fd: int) -> None:  # the disk fills as the report's bytes reach it
+        if "report" in os.readlink(f"/proc/self/fd/{fd}"):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)  # a forked child inherits the patch
+    if not forked:
+        monkeypatch.setattr(pipeline, "_can_fork", lambda: False)
+    elif not pipeline._can_fork():
+        pytest.skip("the report is drawn in a forked child only on Linux with 2+ CPUs")
+    before = tree(tmp_path)
+    code = main(["build", str(HARMONIC), "-o", str(outdir), "-q", "--only", "tables,report"])
+    err = capsys.readouterr().err.splitlines()
+    assert code == 2
+    assert err == [
+        f"camcad: error: --output: cannot write {outdir / 'report.html'}: no space left on device; "
+        "free space on that disk or choose another --output"
+    ]
+    assert tree(tmp_path) == before
+
+
+# --------------------------------------------------------------------------- Ctrl-C at any moment
+
+# ``python -m camcad`` after a hand-shake: the launcher says "go" once the interpreter has started, then
+# runs the module as ``-m`` does. The interpreter's own start-up and its search for the package (a few
+# ms, more on a loaded machine) come before any camcad code: Python's, not camcad's, so the delays
+# start 40 ms after "go"; from there on the package, then camcad.cli, then the command import.
+_LAUNCH = (
+    "import runpy, sys; sys.stdout.write('go\\n'); sys.stdout.flush(); "
+    "sys.argv[0] = '-m'; runpy._run_module_as_main('camcad')"
+)
+
+
+def _site_packages() -> list[str]:
+    import site
+
+    return [*site.getsitepackages(), site.getusersitepackages()]
+
+
+def test_a_sigint_while_modules_import_is_one_line_and_exit_130():
+    """At 10-500 ms after the interpreter started: one line and exit 130, never a traceback of camcad's.
+
+    A signal that comes while Python itself still looks for the package (before camcad's first line)
+    gets Python's own answer; on a loaded machine that can take tens of milliseconds, so those runs are
+    told apart by their traceback holding no camcad frame, and most runs must land in camcad's code.
+    """
+    env = environment()
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *_site_packages()])  # -S: no .pth start-up
+    clean = 0
+    delays = [0.01, 0.02, 0.04, 0.07, 0.1, 0.15, 0.2, 0.3, 0.5]
+    for delay in delays:
+        proc = subprocess.Popen(
+            [sys.executable, "-S", "-c", _LAUNCH, "check", str(ROOT / "samples" / "quintero_vap_b01.toml")],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        assert proc.stdout.readline() == "go\n"
+        time.sleep(delay)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+        assert out == "", (delay, out)
+        if err == "camcad: interrupted\n" and proc.returncode == 130:
+            clean += 1
+            continue
+        # Python's own window: it was still finding the package, no line of camcad had run
+        assert "camcad" not in err and err.endswith("KeyboardInterrupt\n"), (delay, err)
+        assert proc.returncode == -signal.SIGINT, (delay, proc.returncode)
+    assert clean >= len(delays) - 3, clean
