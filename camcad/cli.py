@@ -311,7 +311,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         objective = ", ".join(f"{k} = {_fmt(v)}" for k, v in cand.objectives.items())
         print(f"{head}{'' if cand.feasible else ' (INFEASIBLE)'}: {objective}")
         for name, value in cand.values.items():
-            print(f"  {name} = {value:.6g}" if isinstance(value, float) else f"  {name} = {value}")
+            print(f"  {name} = {value!r}" if isinstance(value, float) else f"  {name} = {value}")  # exact
         for c in cand.constraints:
             limit = f" (limit {c.limit:g})" if math.isfinite(c.limit) else ""
             print(f"  {'*' if c.active else ' '} {c.name:<48} {_fmt(c.value)}{limit}")
