@@ -5,7 +5,11 @@ from __future__ import annotations
 import csv
 import io
 import math
+import os
 import re
+import subprocess
+import sys
+import time
 from html.parser import HTMLParser
 
 import pytest
@@ -298,3 +302,40 @@ def test_bad_options_exit_2_naming_the_flag(args, flag, tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2
     assert err.startswith(f"camcad: error: {flag}:"), err
+
+
+def _timed_cli(*args: str) -> tuple[float, subprocess.CompletedProcess[str]]:
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    start = time.monotonic()
+    done = subprocess.run(
+        [sys.executable, "-m", "camcad", *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+    return time.monotonic() - start, done
+
+
+@pytest.mark.parametrize(
+    ("address", "words"),
+    [("not a url", "is not a scheduler address"), ("tcp://127.0.0.1:1", "cannot reach the Dask scheduler")],
+    ids=["not-an-address", "refused-port"],
+)
+def test_a_bad_scheduler_fails_fast_with_one_line_and_no_traceback(address, words, tmp_path):
+    """Issue 32: one line, exit 2, within seconds of a run that fails at once on another option; and
+    nothing later (Dask's client finaliser used to print a traceback 40 s on)."""
+    grid = ["--grid", "base_radius=40:80:2", "--format"]
+    baseline, _ = _timed_cli("sweep", SAMPLE, *grid, "xlsx", "-o", str(tmp_path / "b"))  # imports, load
+    seconds, done = _timed_cli(
+        "sweep", SAMPLE, *grid, "csv", "--scheduler", address, "-o", str(tmp_path / "o")
+    )
+    assert done.returncode == 2, done.stderr
+    assert done.stdout == ""
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("camcad: error: --scheduler: "), lines
+    assert words in lines[0]
+    assert "Traceback" not in done.stderr
+    assert seconds < max(10.0, baseline + 5.0), (seconds, baseline)
+    assert not (tmp_path / "o").exists()
