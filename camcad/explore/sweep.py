@@ -31,10 +31,13 @@ import contextlib
 import json
 import logging
 import math
+import os
 import re
 import shutil
+import signal
 import socket
 import sys
+import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
@@ -122,11 +125,69 @@ def _serial(chunks: Sequence[Chunk]) -> Iterator[tuple[int, list[dict[str, Any]]
         yield k, evaluate_chunk(chunk)
 
 
+PARENT_POLL_S = 0.2
+"""How often a local worker checks that the sweep that started it still runs [s]."""
+
+
+def _gone(pid: int) -> bool:
+    """Whether process ``pid`` has ended: no such process, or a zombie its own parent has not reaped yet."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as stat:
+            return stat.read().rpartition(b")")[2].split()[0] in (b"Z", b"X")
+    except FileNotFoundError:
+        return True
+    except OSError:  # no /proc here: ask the kernel whether it can be signalled
+        pass
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OSError:  # another user's process: it exists
+        pass
+    return False
+
+
+def _die_with(parent: int) -> None:
+    """Run in each local worker as it starts: end it when the sweep process ``parent`` is gone.
+
+    A sweep killed outright (SIGKILL, out of memory) cannot stop its pool,
+    so each worker watches for itself: a daemon thread asks every
+    :data:`PARENT_POLL_S` whether ``parent`` still exists and ends the worker
+    at once when not (on Linux the kernel also ends it with its own parent,
+    the fork server, by ``PR_SET_PDEATHSIG``). The worker's stdout is the null
+    device, so no worker holds the caller's pipe open (``camcad sweep … | tee``).
+    """
+    import threading
+
+    with contextlib.suppress(OSError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.close(devnull)
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        with contextlib.suppress(OSError, AttributeError):
+            pr_set_pdeathsig = 1  # <linux/prctl.h>
+            ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
+
+    def watch() -> None:
+        while not _gone(parent):
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="camcad-parent-watch", daemon=True).start()
+
+
 def _processes(chunks: Sequence[Chunk], jobs: int) -> Iterator[tuple[int, list[dict[str, Any]]]]:
     import multiprocessing
 
     method = "forkserver" if sys.platform != "win32" else "spawn"
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context(method)) as pool:
+    with ProcessPoolExecutor(
+        max_workers=jobs,
+        mp_context=multiprocessing.get_context(method),
+        initializer=_die_with,
+        initargs=(os.getpid(),),
+    ) as pool:
         futures = {pool.submit(evaluate_chunk, chunk): k for k, chunk in enumerate(chunks)}
         try:
             for future in as_completed(futures):

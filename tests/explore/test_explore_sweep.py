@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
+import threading
 import time
 from html.parser import HTMLParser
 
@@ -339,3 +342,50 @@ def test_a_bad_scheduler_fails_fast_with_one_line_and_no_traceback(address, word
     assert "Traceback" not in done.stderr
     assert seconds < max(10.0, baseline + 5.0), (seconds, baseline)
     assert not (tmp_path / "o").exists()
+
+
+def _group(pgid: int) -> list[tuple[int, str]]:
+    """(pid, state) of every process of the process group ``pgid``, read from /proc."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat", "rb") as stat:
+                    fields = stat.read().rpartition(b")")[2].split()
+            except OSError:
+                continue
+            if int(fields[2]) == pgid:
+                found.append((int(entry), fields[0].decode()))
+    return found
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads the process table from /proc")
+def test_a_killed_sweep_takes_its_workers_fork_server_and_tracker_with_it(tmp_path):
+    """Issue 32: SIGKILL of `camcad sweep --jobs 2`: within seconds no process of its group is left
+    running (workers, fork server, resource tracker) and the caller's stdout pipe reaches EOF."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    args = ["--grid", "base_radius=40:80:60", "--chunk-size", "1", "--jobs", "2", "--format", "csv"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "camcad", "sweep", SAMPLE, *args, "-o", str(tmp_path / "o"), "-q"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        env=env,
+        start_new_session=True,  # its own process group: everything it starts is found by its id
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while len(_group(proc.pid)) < 5:  # the sweep, the tracker, the fork server and two workers
+            assert proc.poll() is None and time.monotonic() < deadline, _group(proc.pid)
+            time.sleep(0.05)
+        proc.kill()
+        eof = threading.Event()
+        threading.Thread(target=lambda: (proc.stdout.read(), eof.set()), daemon=True).start()
+        assert eof.wait(15), "a process still holds the caller's stdout"
+        deadline = time.monotonic() + 15
+        while [p for p, state in _group(proc.pid) if p != proc.pid and state not in "ZX"]:
+            assert time.monotonic() < deadline, _group(proc.pid)
+            time.sleep(0.1)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=60)
