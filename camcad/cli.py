@@ -16,6 +16,7 @@ import os
 import signal
 import sys
 import threading
+import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager, suppress
 from pathlib import Path
@@ -582,6 +583,18 @@ def _no_library_logging() -> Iterator[None]:
         root.removeHandler(handler)
 
 
+@contextmanager
+def _no_library_warnings() -> Iterator[None]:
+    """Keep Python warnings of the libraries camcad uses (a SciPy ``RuntimeWarning``) off stderr.
+
+    camcad reports what matters as findings, notes and errors of its own;
+    a library's warning is a line the user cannot act on.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        yield
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line and return the exit code.
 
@@ -633,7 +646,7 @@ def _run(argv: Sequence[str] | None) -> int:
     """Parse, run the command, and map its errors to one line and an exit code."""
     try:
         args = build_parser().parse_args(argv)
-        with _terminate_like_interrupt(), _no_library_logging():
+        with _terminate_like_interrupt(), _no_library_logging(), _no_library_warnings():
             code = int(args.handler(args))
             sys.stdout.flush()
         return code

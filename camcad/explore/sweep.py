@@ -158,7 +158,9 @@ def _die_with(parent: int) -> None:
     device, so no worker holds the caller's pipe open (``camcad sweep … | tee``).
     """
     import threading
+    import warnings
 
+    warnings.simplefilter("ignore")  # as in the command line: a library's warnings are not camcad's lines
     with contextlib.suppress(OSError):
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, 1)

@@ -111,6 +111,76 @@ def test_a_disk_that_fills_while_the_report_is_written_names_report_html(
     assert tree(tmp_path) == before
 
 
+# --------------------------------------------------------------------------- nothing but camcad's lines
+
+# A home folder this user may not read. The tests run as root, whom no folder mode stops, so the
+# script makes every path below HOME answer as it does for another user with HOME at mode 000.
+_UNREADABLE_HOME = """
+import os, pathlib, sys
+home = pathlib.Path(os.environ["HOME"])
+real_exists = pathlib.Path.exists
+
+def exists(self, *args, **kwargs):
+    if self == home or home in self.parents:
+        raise PermissionError(13, "Permission denied", str(self))
+    return real_exists(self, *args, **kwargs)
+
+pathlib.Path.exists = exists
+from camcad.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+# A library warning inside a stage (SciPy's RuntimeWarning on a long table), raised on purpose.
+_LIBRARY_WARNING = """
+import sys, warnings
+import camcad.pipeline as pipeline
+real = pipeline.analyse
+
+def analyse(*args, **kwargs):
+    warnings.warn("invalid value encountered in divide", RuntimeWarning, stacklevel=1)
+    return real(*args, **kwargs)
+
+pipeline.analyse = analyse
+from camcad.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def _script(script: str, *args: str, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", script, *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+        check=False,
+    )
+
+
+def test_an_unreadable_home_prints_nothing_of_ezdxfs_font_scan(tmp_path):
+    """ezdxf's font scan at import printed one `Permission denied` line per font folder under HOME."""
+    home = tmp_path / "home"
+    (home / ".fonts").mkdir(parents=True)
+    out = tmp_path / "out"
+    env = environment(HOME=str(home), XDG_CONFIG_HOME=None, XDG_CACHE_HOME=None)
+    done = _script(_UNREADABLE_HOME, "build", str(HARMONIC), "-o", str(out), "-q", "--only", "dxf", env=env)
+    assert done.returncode == 0, done.stderr
+    assert (done.stdout, done.stderr) == ("", "")  # -q: camcad itself prints nothing
+    assert sorted(p.name for p in out.iterdir()) == [
+        "profile.dxf",
+        "profile_arcs.dxf",
+        "profile_poly.dxf",
+        "summary.json",
+    ]
+
+
+def test_a_library_warning_in_a_stage_stays_off_stderr(tmp_path):
+    done = _script(_LIBRARY_WARNING, "check", str(HARMONIC), env=environment())
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
+    assert done.stdout.splitlines()[-1] == "all design limits hold"
+
+
 # --------------------------------------------------------------------------- Ctrl-C at any moment
 
 # ``python -m camcad`` after a hand-shake: the launcher says "go" once the interpreter has started, then
