@@ -10,9 +10,7 @@ Every public name is imported on first use (:func:`__getattr__`), so
 command line installs its Ctrl-C handling before NumPy and SciPy load.
 """
 
-from __future__ import annotations
-
-import os
+import os  # already loaded by Python itself, as sys: nothing here takes time before the handler
 import sys
 
 
@@ -25,13 +23,15 @@ def _exit_interrupted(signum: int, frame: object) -> None:
 # ``python -m camcad`` (argv[0] is "-m" while the package imports) or the ``camcad`` command is
 # importing this package: answer Ctrl-C from now on (camcad.cli.main takes over when it runs)
 if sys.argv[:1] == ["-m"] or os.path.basename(sys.argv[0] if sys.argv else "") in ("camcad", "camcad.exe"):
-    import _signal  # the C module: ``signal`` imports ``enum``, itself a window of milliseconds
+    import _signal  # type: ignore[import-not-found]  # the C module: ``signal`` imports ``enum``, itself a window of milliseconds
 
     _signal.signal(_signal.SIGINT, _exit_interrupted)
 
 from importlib import import_module  # noqa: E402 - after the Ctrl-C handling, on purpose
 
 from camcad._version import __version__  # noqa: E402
+
+# no ``from __future__ import annotations`` here: it is a real import, a window before the handler
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing (mypy reads it the same way)
 

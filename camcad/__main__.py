@@ -9,7 +9,7 @@ later moment, where :func:`camcad.cli.main` turns it into a clean stop.
 import sys
 
 if __name__ == "__main__":
-    import _signal  # the C module: importing ``signal`` takes milliseconds (enum)
+    import _signal  # type: ignore[import-not-found]  # the C module: importing ``signal`` takes milliseconds (enum)
 
     from camcad import _exit_interrupted
 
