@@ -16,12 +16,14 @@ import os
 import signal
 import sys
 import threading
+import warnings
 from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from types import FrameType
 from typing import TYPE_CHECKING, Any
 
+from camcad import _exit_interrupted
 from camcad._version import __version__
 from camcad.errors import (
     EXIT_INTERRUPTED,
@@ -33,6 +35,7 @@ from camcad.errors import (
     CamcadError,
     DesignLimitError,
     exit_code,
+    printable,
 )
 
 if TYPE_CHECKING:
@@ -45,7 +48,7 @@ class _Parser(argparse.ArgumentParser):
     """An argument parser that exits 2 with one clear line (argparse's own code for usage errors)."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(EXIT_INVALID, f"camcad: error: {message} (see '{self.prog} --help')\n")
+        self.exit(EXIT_INVALID, f"camcad: error: {printable(message)} (see '{self.prog} --help')\n")
 
 
 def _progress(quiet: bool) -> Progress | None:
@@ -357,15 +360,17 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     from camcad.explore.files import write_optimize
     from camcad.explore.measures import measure, parse_limit
     from camcad.explore.optimize import Problem, optimize
-    from camcad.explore.space import parse_variable
+    from camcad.explore.space import check_distinct, parse_variable
 
     data = _design_mapping(args.design)
+    variables = tuple(
+        parse_variable(v, data, flag="--vary", counted=False, source=args.design) for v in args.vary
+    )
+    check_distinct(variables, data, flag="--vary")
     problem = Problem(
         data=data,
         source=args.design,
-        variables=tuple(
-            parse_variable(v, data, flag="--vary", counted=False, source=args.design) for v in args.vary
-        ),
+        variables=variables,
         objectives=tuple(measure(m.strip(), "--minimize") for m in ",".join(args.minimize).split(",")),
         limits=tuple(parse_limit(text) for text in args.limit),
         method=args.method,
@@ -385,7 +390,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         objective = ", ".join(f"{k} = {_fmt(v)}" for k, v in cand.objectives.items())
         print(f"{head}{'' if cand.feasible else ' (INFEASIBLE)'}: {objective}")
         for name, value in cand.values.items():
-            print(f"  {name} = {value:.6g}" if isinstance(value, float) else f"  {name} = {value}")
+            print(f"  {name} = {value!r}" if isinstance(value, float) else f"  {name} = {value}")  # exact
         for c in cand.constraints:
             limit = f" (limit {c.limit:g})" if math.isfinite(c.limit) else ""
             print(f"  {'*' if c.active else ' '} {c.name:<48} {_fmt(c.value)}{limit}")
@@ -402,9 +407,10 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from camcad.errors import UsageError
     from camcad.explore.measures import measure, parse_limit
-    from camcad.explore.space import grid_points, lhs_points, parse_variable
+    from camcad.explore.space import check_distinct, check_seed, grid_points, lhs_points, parse_variable
     from camcad.explore.sweep import SweepPlan, sweep
 
+    check_seed(args.seed)
     data = _design_mapping(args.design)
     counted = args.samples is None
     variables = tuple(
@@ -412,6 +418,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     )
     if not variables:
         raise UsageError("--grid", "give at least one, e.g. --grid base_radius=30:80:51")
+    check_distinct(variables, data, flag="--grid")
     names = [m.strip() for m in args.pareto.split(",")]
     if len(names) != 2:
         raise UsageError("--pareto", f"{args.pareto!r}: name two quantities, e.g. base_radius,contact_stress")
@@ -654,11 +661,70 @@ def _no_library_logging() -> Iterator[None]:
         root.removeHandler(handler)
 
 
+@contextmanager
+def _no_library_warnings() -> Iterator[None]:
+    """Keep Python warnings of the libraries camcad uses (a SciPy ``RuntimeWarning``) off stderr.
+
+    camcad reports what matters as findings, notes and errors of its own;
+    a library's warning is a line the user cannot act on.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        yield
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the camcad command line and return the exit code."""
-    args = build_parser().parse_args(argv)
+    """Run the command line and return the exit code.
+
+    Ctrl-C (SIGINT, and SIGTERM, SIGHUP) at any moment gives one line,
+    ``camcad: interrupted``, and exit 130: while a command runs it raises
+    ``KeyboardInterrupt``, which cleans up (a staged output folder is
+    removed); when this function is the process's entry point (the
+    ``camcad`` command, ``python -m camcad``), a signal after it returns ends
+    the process the same way. The heavy modules are imported by the command
+    after the handling is in place.
+    """
+    entry = _is_entry_point()
+    previous: Any = None
+    code = EXIT_INTERRUPTED
     try:
-        with _terminate_like_interrupt(), _no_library_logging():
+        if threading.current_thread() is threading.main_thread():
+            previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+        try:
+            code = _run(argv)
+        except KeyboardInterrupt:  # a signal while an error line was printed
+            print("camcad: interrupted", file=sys.stderr)
+    except KeyboardInterrupt:  # the moment the handling was put in place
+        print("camcad: interrupted", file=sys.stderr)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, _exit_interrupted if entry else previous)
+    if entry and code == EXIT_INTERRUPTED:
+        # CPython 3.11 remembers an interrupt that went through exec() of a string (dataclasses,
+        # namedtuple) and then ends the process by SIGINT at exit, though camcad handled it; the
+        # clean-up has run, so leave now with the documented code
+        with suppress(OSError, ValueError):
+            sys.stdout.flush()
+        with suppress(OSError, ValueError):
+            sys.stderr.flush()
+        os._exit(EXIT_INTERRUPTED)
+    return code
+
+
+def _is_entry_point() -> bool:
+    """Whether :func:`main` runs as the process's command (so a later SIGINT may end the process at once)."""
+    main_module = sys.modules.get("__main__")
+    spec = getattr(main_module, "__spec__", None)
+    if spec is not None and spec.name == "camcad.__main__":  # python -m camcad
+        return True
+    return os.path.basename(sys.argv[0] if sys.argv else "") in ("camcad", "camcad.exe")  # the command
+
+
+def _run(argv: Sequence[str] | None) -> int:
+    """Parse, run the command, and map its errors to one line and an exit code."""
+    try:
+        args = build_parser().parse_args(argv)
+        with _terminate_like_interrupt(), _no_library_logging(), _no_library_warnings():
             code = int(args.handler(args))
             sys.stdout.flush()
         return code
@@ -669,16 +735,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         _silence_stdout()
         return EXIT_PIPE_CLOSED
     except DesignLimitError as err:
-        print(f"camcad: design limit: {err}", file=sys.stderr)
+        _say("design limit", str(err))
         return exit_code(err)
     except CamcadError as err:
-        print(f"camcad: error: {err}", file=sys.stderr)
+        _say("error", str(err))
         return exit_code(err)
     except OSError as err:
-        where = f": {err.filename}" if err.filename else ""
-        print(f"camcad: error: {err.strerror or err}{where}", file=sys.stderr)
+        where = f": {os.fsdecode(err.filename)}" if err.filename else ""
+        _say("error", f"{err.strerror or err}{where}")
         return exit_code(err)
     except Exception as err:  # the one place that maps surprises to exit 1
-        print(f"camcad: unexpected error: {type(err).__name__}: {err}", file=sys.stderr)
+        _say("unexpected error", f"{type(err).__name__}: {err}")
         print("camcad: please report this with your design file", file=sys.stderr)
         return EXIT_UNEXPECTED
+
+
+def _say(kind: str, message: str) -> None:
+    """Print ``camcad: <kind>: <message>`` as one line on stderr: every user string in it escaped."""
+    print(f"camcad: {kind}: {printable(message)}", file=sys.stderr)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import errno
 import os
+import unicodedata
 
 __all__ = [
     "EXIT_INTERRUPTED",
@@ -33,6 +34,7 @@ __all__ = [
     "UndercutError",
     "UsageError",
     "exit_code",
+    "printable",
 ]
 
 EXIT_OK = 0
@@ -43,10 +45,33 @@ EXIT_INTERRUPTED = 130  # 128 + SIGINT, also used for SIGTERM and SIGHUP
 EXIT_PIPE_CLOSED = 141  # 128 + SIGPIPE: the reader of stdout went away
 
 
+def printable(text: str) -> str:
+    r"""``text`` with every control character and line or paragraph separator escaped (``\n``, ``\x1b``).
+
+    A user's string in an error line (a file name with a newline in it)
+    cannot start a second line or move the cursor: the message stays one line.
+
+    Examples
+    --------
+    >>> printable("a.csv\ncamcad: error: forged")
+    'a.csv\\ncamcad: error: forged'
+    """
+    if text.isprintable():
+        return text
+    return "".join(
+        ch.encode("unicode_escape").decode("ascii") if unicodedata.category(ch) in ("Cc", "Zl", "Zp") else ch
+        for ch in text
+    )
+
+
 class CamcadError(Exception):
-    """Base class for all camcad errors."""
+    """Base class for all camcad errors (its text is one line: control characters escaped)."""
 
     exit_code: int = EXIT_UNEXPECTED
+
+    def __str__(self) -> str:
+        """The message with control characters escaped (:func:`printable`)."""
+        return printable(super().__str__())
 
 
 class DesignError(CamcadError, ValueError):
@@ -113,7 +138,7 @@ class OutputError(CamcadError, OSError):
 
     def __str__(self) -> str:
         """The one-line message (``OSError`` would format errno and filename instead)."""
-        return str(self.args[0])
+        return printable(str(self.args[0]))
 
     @classmethod
     def from_os_error(cls, err: OSError, path: str | os.PathLike[str]) -> OutputError:

@@ -474,7 +474,7 @@ class _Background:
         if kind == "ok":
             return value, float(extra)
         if extra is not None:
-            raise extra
+            raise _unpickled(extra)
         name, message = value
         raise ExportError(f"report: {name}: {message}")
 
@@ -488,12 +488,41 @@ class _Background:
         os.close(self._read)
 
 
-def _picklable(err: BaseException) -> BaseException | None:
-    """The exception itself if it survives a pickle round trip, else None (its name and text go instead)."""
+def _picklable(err: BaseException) -> Any:
+    """What brings ``err`` back across the pipe: the exception itself, a recipe for it, or None.
+
+    Most exceptions survive a pickle round trip. Those whose ``__init__``
+    takes other arguments than their ``args`` (``OutputError(path, problem,
+    advice)``, ``DesignError(path, message)``) do not; they travel as a recipe
+    (class, ``args``, attributes, and ``errno``, ``strerror``, ``filename`` of an
+    ``OSError``) that :func:`_unpickled` rebuilds without calling ``__init__``,
+    so a full disk while the report is written is the same ``OutputError`` as
+    anywhere else. None when neither travels (its name and text go instead).
+    """
     try:
         pickle.loads(pickle.dumps(err))
-    except Exception:  # any exception that cannot travel
+        return err
+    except Exception:  # any exception that cannot travel as it is
+        pass
+    fields = (err.errno, err.strerror, err.filename) if isinstance(err, OSError) else None
+    recipe = ("recipe", type(err), err.args, dict(getattr(err, "__dict__", {})), fields)
+    try:
+        _unpickled(pickle.loads(pickle.dumps(recipe)))
+    except Exception:  # a local class, an attribute that cannot travel
         return None
+    return recipe
+
+
+def _unpickled(extra: Any) -> BaseException:
+    """The exception :func:`_picklable` sent: itself, or rebuilt from its recipe."""
+    if not isinstance(extra, tuple):
+        return extra  # type: ignore[no-any-return]
+    _, cls, args, attributes, fields = extra
+    err: BaseException = cls.__new__(cls, *args)
+    err.args = args
+    err.__dict__.update(attributes)
+    if fields is not None:
+        err.errno, err.strerror, err.filename = fields  # type: ignore[attr-defined]
     return err
 
 

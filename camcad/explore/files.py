@@ -28,10 +28,18 @@ def _header(problem: Problem, cand: Candidate, what: str) -> str:
     values = ", ".join(f"{k} = {v!r}" for k, v in cand.values.items())
     objectives = ", ".join(f"{k} = {v:.6g}" for k, v in cand.objectives.items() if v is not None)
     active = ", ".join(cand.active) or "none"
-    return (
+    text = (
         f"{what} of {problem.source or 'the design'} found by camcad optimize\n"
         f"variables: {values}\nobjectives: {objectives}\nactive constraints: {active}"
     )
+    if not cand.feasible:
+        broken = (
+            ", ".join(c.name for c in cand.constraints if c.margin < 0.0) or "the design cannot be analysed"
+        )
+        text = (
+            f"INFEASIBLE: no design within the ranges meets every limit; this one breaks: {broken}\n" + text
+        )
+    return text
 
 
 def _rebased(data: dict[str, Any], source: str, outdir: Path) -> dict[str, Any]:

@@ -23,7 +23,11 @@ the single constraint max |α| ≤ A would hide from a gradient method.
 
 Constraints are met with a small reserve (:data:`RESERVE`, relative), so the
 design file of the optimum passes ``camcad check`` and not only the
-solver's tolerance. A constraint is reported *active* when its margin is
+solver's tolerance. A candidate is feasible when every limit holds as
+``camcad check`` judges it (margin ≥ 0). The optimum's values are given with
+the fewest significant digits (6 to 17) at which the design, analysed again,
+is still feasible: the values printed, written to ``optimum.toml`` and typed
+back all give the same passing design. A constraint is reported *active* when its margin is
 within :data:`ACTIVE` (relative) of its limit.
 
 Two objectives give a Pareto front by the ε-constraint method: the two
@@ -49,6 +53,9 @@ from camcad.explore.space import Variable, apply_values, design_with
 
 __all__ = [
     "ACTIVE",
+    "MAX_COMBINATIONS",
+    "MAX_FRONT_POINTS",
+    "MAX_STARTS",
     "METHODS",
     "RESERVE",
     "Candidate",
@@ -64,6 +71,12 @@ RESERVE = 1e-7
 """Relative margin the solver must keep from every limit (so the optimum passes ``camcad check``)."""
 ACTIVE = 1e-4
 """A constraint whose relative margin is below this is reported active."""
+MAX_STARTS = 1000
+"""Most local searches (``--starts``) per combination of the discrete choices."""
+MAX_FRONT_POINTS = 200
+"""Most points of a two-objective front (``--points``)."""
+MAX_COMBINATIONS = 1000
+"""Most combinations of the discrete choices (``--vary name=a,b,…``), each a full optimisation."""
 _INVALID = -10.0  # the relative margin of every constraint at a design that cannot be analysed
 _FD_STEP = 1e-7  # finite-difference step on the variables scaled to [0, 1]
 _EDGE_STEP = 1e-5  # scaled step that probes whether an optimum sits on the edge of the valid designs
@@ -261,23 +274,24 @@ class _Evaluator:
             out.append(float(v.low + float(np.clip(u, 0.0, 1.0)) * (v.high - v.low)))
         return tuple(out)
 
-    def variables_values(self, x: np.ndarray) -> tuple[list[Variable], list[Any]]:
-        return (
-            [v for v, _ in self.fixed] + self.free,
-            [c for _, c in self.fixed] + list(self.physical(x)),
-        )
+    def values_at(self, physical: Sequence[float]) -> tuple[list[Variable], list[Any]]:
+        """The variables and their values with the continuous ones at ``physical`` (design-file units)."""
+        return [v for v, _ in self.fixed] + self.free, [c for _, c in self.fixed] + list(physical)
 
     def __call__(self, x: np.ndarray) -> _Point:
-        key = self.physical(x)
-        if key not in self.cache:
-            self.cache[key] = self._evaluate(x)
-        return self.cache[key]
+        return self.at(self.physical(x))
 
-    def _evaluate(self, x: np.ndarray) -> _Point:
+    def at(self, physical: tuple[float, ...]) -> _Point:
+        """The analysed variant with the continuous variables at ``physical`` (design-file units)."""
+        if physical not in self.cache:
+            self.cache[physical] = self._evaluate(physical)
+        return self.cache[physical]
+
+    def _evaluate(self, physical: tuple[float, ...]) -> _Point:
         from camcad.geometry.sizing import feasible_margins
         from camcad.pipeline import analyse
 
-        variables, values = self.variables_values(x)
+        variables, values = self.values_at(physical)
         try:
             design = design_with(self.problem.data, variables, values, source=self.problem.source)
             analysis = analyse(design, fit=False, toolpath=False, strict=False)
@@ -388,9 +402,12 @@ def _candidate(
     message: str,
     *,
     limits: Sequence[Limit],
+    physical: tuple[float, ...] | None = None,
 ) -> Candidate:
-    point = ev(x)
-    variables, values = ev.variables_values(x)
+    """The candidate at scaled ``x``, or at the continuous values ``physical`` when given (rounded ones)."""
+    physical = ev.physical(x) if physical is None else physical
+    point = ev.at(physical)
+    variables, values = ev.values_at(physical)
     constraint_values, margins = _constraints(point, limits)
     limit_values = [lim.value for lim in limits for _ in range(_width(lim))] + [math.nan]
     states = [
@@ -422,7 +439,7 @@ def _candidate(
         measures=dict(point.measures),
         constraints=tuple(states),
         bounds=tuple(bounds),
-        feasible=point.valid and bool(np.all(margins >= -RESERVE)),
+        feasible=point.valid and bool(np.all(margins >= 0.0)),  # every limit holds, as `camcad check` judges
         data=apply_values(ev.problem.data, variables, values),
         evaluations=len(ev.cache),
         message=message,
@@ -487,13 +504,44 @@ def _minimise(
     limits: Sequence[Limit],
 ) -> Candidate:
     best: Candidate | None = None
+    best_x = np.zeros(len(ev.free))
     for x0 in starts:
         x, message = _solve(ev, objective, x0, method=method, limits=limits)
         cand = _candidate(ev, x, objectives, message, limits=limits)
         if _better(cand, best, objective):
-            best = cand
+            best, best_x = cand, x
     assert best is not None
-    return best
+    return _shortest(ev, best, best_x, objectives, limits=limits)
+
+
+def _shortest(
+    ev: _Evaluator, cand: Candidate, x: np.ndarray, objectives: Sequence[Measure], *, limits: Sequence[Limit]
+) -> Candidate:
+    """The candidate at the fewest significant digits (6 to 17) of its values that keep it feasible.
+
+    The values printed, written to the design file and typed back then give a
+    design that passes. At an optimum limits are active: rounding a value to
+    six digits can step over one (a corner of two pressure-angle limits moves
+    by 10⁻⁵ mm). Each rounding is analysed again; at 17
+    digits the value is the solver's own, so a feasible candidate stays feasible.
+    """
+    if not cand.feasible or not ev.free:
+        return cand
+    exact = ev.physical(x)
+    for digits in range(6, 17):
+        rounded = tuple(float(f"{v:.{digits}g}") for v in exact)
+        inside = all(
+            v.low is not None and v.high is not None and v.low <= r <= v.high
+            for r, v in zip(rounded, ev.free, strict=True)
+        )
+        if not inside:
+            continue
+        if rounded == exact:
+            return cand
+        trial = _candidate(ev, x, objectives, cand.message, limits=limits, physical=rounded)
+        if trial.feasible:
+            return trial
+    return cand
 
 
 def optimize(problem: Problem, *, progress: Callable[[str], None] | None = None) -> OptimizeResult:
@@ -511,12 +559,21 @@ def optimize(problem: Problem, *, progress: Callable[[str], None] | None = None)
         raise UsageError("--minimize", "give one objective, or two different ones for a Pareto front")
     if not problem.variables:
         raise UsageError("--vary", "give at least one variable, e.g. --vary base_radius=20:120")
-    if problem.starts < 1:
-        raise UsageError("--starts", f"{problem.starts} is not allowed (allowed: 1 or more)")
-    if len(problem.objectives) == 2 and problem.points < 2:
-        raise UsageError("--points", f"{problem.points} is not allowed (allowed: 2 or more)")
+    if not 1 <= problem.starts <= MAX_STARTS:
+        raise UsageError("--starts", f"{problem.starts} is not allowed (allowed: 1 to {MAX_STARTS})")
+    if problem.points > MAX_FRONT_POINTS or (len(problem.objectives) == 2 and problem.points < 2):
+        raise UsageError("--points", f"{problem.points} is not allowed (allowed: 2 to {MAX_FRONT_POINTS})")
+    if not 0 <= problem.seed <= 2**32 - 1:
+        raise UsageError("--seed", f"{problem.seed} is not allowed (allowed: 0 to {2**32 - 1})")
     limits = design_limits(problem.data, problem.limits, source=problem.source)
     discrete = [v for v in problem.variables if not v.continuous]
+    count = math.prod(len(v.choices or ()) for v in discrete)
+    if count > MAX_COMBINATIONS:
+        raise UsageError(
+            "--vary",
+            f"{count} combinations of the choices; allowed: at most {MAX_COMBINATIONS} "
+            "(each is a full optimisation: list fewer choices, or make a variable a range low:high)",
+        )
     combos = list(itertools.product(*(v.choices or () for v in discrete)))
     tried: list[Candidate] = []
     everything: list[Candidate] = []

@@ -38,9 +38,13 @@ from camcad.motion.laws import LAWS
 
 __all__ = [
     "ALIASES",
+    "MAX_CHOICES",
     "MAX_POINTS",
+    "MAX_SEED",
     "Variable",
     "apply_values",
+    "check_distinct",
+    "check_seed",
     "design_with",
     "grid_points",
     "lhs_points",
@@ -66,6 +70,12 @@ ALIASES: dict[str, str] = {
 
 MAX_POINTS = 10_000_000
 """Most designs one sweep may list (a grid's product or ``--samples``)."""
+
+MAX_CHOICES = 1000
+"""Most choices one variable may list (``name=a,b,…``); more values are a range ``start:stop:count``."""
+
+MAX_SEED = 2**32 - 1
+"""Largest Latin-hypercube seed (``--seed``: 0 to 2³² − 1, what NumPy's seeding takes as one word)."""
 
 _PATH = re.compile(r"^(?P<table>[a-z_]+)(?:\[(?P<index>\d+|\*)\])?\.(?P<key>[A-Za-z0-9_-]+)$")
 _MOVING = ("rise", "return")
@@ -238,6 +248,13 @@ def parse_variable(
         variable = Variable(name=name, path=path, low=low, high=high, count=count)
         trials: tuple[Any, ...] = (low, high)
     else:
+        listed = spec.count(",") + 1
+        if listed > MAX_CHOICES:
+            raise UsageError(
+                flag,
+                f"{name}: {listed} choices; allowed: at most {MAX_CHOICES} (for more values use a range, "
+                f"{name}=start:stop:count)",
+            )
         choices = tuple(_token(c) for c in spec.split(",") if c.strip())
         if not choices:
             raise UsageError(flag, f"{text!r}: list at least one value")
@@ -307,12 +324,37 @@ def design_with(
     return parse_design(apply_values(data, variables, values), source=source)
 
 
+def check_distinct(variables: Sequence[Variable], data: Mapping[str, Any], *, flag: str) -> None:
+    """Raise UsageError naming ``flag`` when two variables set the same key of the design.
+
+    ``base_radius`` twice, ``base_radius`` and ``cam.base_radius``, or
+    ``law`` and ``motion[0].law`` (``law`` sets every rise and return): the
+    later would silently overwrite the earlier.
+    """
+    seen: dict[tuple[str, int | None, str], str] = {}
+    for v in variables:
+        for place in _targets(v.path, data, flag, v.name):
+            if place in seen:
+                table, index, key = place
+                where = f"{table}[{index}].{key}" if index is not None else f"{table}.{key}"
+                both = v.name if seen[place] == v.name else f"{seen[place]} and {v.name}"
+                raise UsageError(flag, f"{both}: the key {where} is given twice (give each key once)")
+        for place in _targets(v.path, data, flag, v.name):
+            seen[place] = v.name
+
+
 def grid_points(variables: Sequence[Variable]) -> list[tuple[Any, ...]]:
     """Every combination of the variables' grid values, the last variable varying fastest."""
     total = math.prod(len(v.grid()) for v in variables)
     if total > MAX_POINTS:
         raise UsageError("--grid", f"{total} designs; allowed: at most {MAX_POINTS} in one sweep")
     return list(itertools.product(*(v.grid() for v in variables)))
+
+
+def check_seed(seed: int) -> None:
+    """Raise UsageError naming ``--seed`` unless 0 ≤ ``seed`` ≤ :data:`MAX_SEED`."""
+    if not 0 <= seed <= MAX_SEED:
+        raise UsageError("--seed", f"{seed} is not allowed (allowed: 0 to {MAX_SEED})")
 
 
 def lhs_points(variables: Sequence[Variable], samples: int, *, seed: int) -> list[tuple[Any, ...]]:
@@ -323,6 +365,7 @@ def lhs_points(variables: Sequence[Variable], samples: int, *, seed: int) -> lis
     """
     if not 1 <= samples <= MAX_POINTS:
         raise UsageError("--samples", f"{samples} is not allowed (allowed: 1 to {MAX_POINTS})")
+    check_seed(seed)
     from scipy.stats import qmc
 
     unit = qmc.LatinHypercube(d=len(variables), rng=np.random.default_rng(seed)).random(samples)

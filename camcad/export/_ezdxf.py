@@ -7,7 +7,8 @@ reads or writes a font cache under ``~/.cache/ezdxf`` (or
 unwritable home folder makes it log warnings that reach stderr. camcad draws
 no text through fonts and wants the same file from every account, so this
 module imports ezdxf with both folders pointing nowhere, without
-``$EZDXF_CONFIG_FILE``, and with ezdxf's logger muted for the import. ezdxf
+``$EZDXF_CONFIG_FILE``, and with ezdxf's logger muted and its stdout (the
+font scan prints the font folders it may not read) sent nowhere for the import. ezdxf
 then lists the system fonts itself (a few ms here) and saves no cache. When
 ezdxf was imported before camcad, it is left as it is.
 
@@ -19,11 +20,12 @@ same drawing gives the same bytes.
 
 from __future__ import annotations
 
+import io
 import logging
 import os
 import sys
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, redirect_stdout
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
@@ -64,7 +66,9 @@ def import_ezdxf() -> ModuleType:
     muted = logger.disabled
     logger.disabled = True
     try:
-        with _environment(_ENVIRONMENT):
+        # the font scan at import prints a folder it may not read (``~/.fonts`` of an unreadable home)
+        # to stdout, where camcad lists the files it wrote: sent nowhere
+        with _environment(_ENVIRONMENT), redirect_stdout(io.StringIO()):
             import ezdxf
     finally:
         logger.disabled = muted

@@ -144,7 +144,7 @@ def _existing_folder(outdir: Path) -> Path:
         raise OutputError(
             repr(os.fspath(outdir)), "the path holds a NUL character", "choose another --output"
         )
-    if os.path.lexists(outdir) and not outdir.is_dir():
+    if os.path.lexists(outdir) and not outdir.is_dir() and not outdir.is_symlink():  # a link: its target
         raise OutputError(
             outdir, "it is a file, not a folder", "remove or rename it, or choose another --output"
         )
@@ -412,17 +412,27 @@ def staged_folder(outdir: str | os.PathLike[str]) -> Iterator[StagedFolder]:
     """
     target = Path(outdir)
     folder = _existing_folder(target)
+    # OUTDIR may be (or lie under) a symbolic link to another file system: stage beside the folder the
+    # link leads to, so the final rename stays within one file system (no "invalid cross-device link")
+    real = Path(os.path.realpath(target))
+    if real != target.absolute():
+        folder = _existing_folder(real)
     _remove_stale_staging(folder)
-    staging = _make_staging(folder, target)
+    staging: Path | None = None
     try:
+        # a signal between the folder's creation and the try below would leave it behind: held back
+        # until ``staging`` names it, then delivered inside this try, whose clean-up removes it
+        with _signals_held():
+            staging = _make_staging(folder, real)
         try:
             yield StagedFolder(path=staging, target=target)
-            _commit(staging, target)
+            _commit(staging, real)
         except OSError as err:
             mapped = _outside_staging(err, staging, target)
             if mapped is err:
                 raise
             raise mapped from err
     finally:
-        with _signals_held():
-            shutil.rmtree(staging, ignore_errors=True)
+        if staging is not None:
+            with _signals_held():
+                shutil.rmtree(staging, ignore_errors=True)

@@ -187,9 +187,11 @@ def _arm_search(cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min:
     both sides of it), so the feasible set need not be a half-line: the search
     scans the admissible range (the arm reaches the base circle and swings
     clear, :func:`camcad.geometry.spec.arm_problem`) on a grid of
-    ``_SCAN_POINTS`` and bisects to 1e-7 mm between the last infeasible and the
-    first feasible grid value. Feasible sets narrower than the grid step are
-    not found (the error says so).
+    ``_SCAN_POINTS`` and the design's own value, and bisects to 1e-7 mm between
+    the last infeasible and the first feasible grid value. Feasible sets
+    narrower than the grid step are not found unless they hold the design's
+    own value (the error says so); a design that meets the limits always has
+    an answer, at or below its own value.
     """
     fol = cam.follower
     swing = float(np.max(cam.motion(phi).s))
@@ -222,8 +224,14 @@ def _arm_search(cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min:
         trial = make(x)
         return trial is not None and _ok(trial, phi, alpha_max, rho_min)
 
+    # the design's own value joins the grid: a design that meets the limits (an optimum, where the
+    # feasible set can be a sliver narrower than the grid step) always has an answer at or below it
+    own = cam.base_radius if knob == "base_radius" else d
+    grid = np.linspace(lo, hi, _SCAN_POINTS)[1:]
+    if lo < own < hi:
+        grid = np.unique(np.append(grid, own))
     previous = x = lo
-    for x in np.linspace(lo, hi, _SCAN_POINTS)[1:]:
+    for x in grid:
         if ok(float(x)):
             break
         previous = float(x)

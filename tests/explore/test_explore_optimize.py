@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import math
+import re
+import time
 
 import numpy as np
 import pytest
@@ -11,6 +13,7 @@ import tomllib
 
 from camcad.cli import main
 from camcad.design import load_design
+from camcad.design.toml_text import toml_text
 from camcad.errors import UsageError
 from camcad.explore.measures import MEASURES, parse_limit
 from camcad.explore.optimize import Problem, optimize
@@ -262,13 +265,41 @@ def test_cli_writes_a_design_file_that_passes_check(tmp_path, capsys):
         (["--vary", "law=cycloidal,warp-drive"], "--vary"),
         (["--vary", "base_radius=20:120", "--limit", "stress<=5"], "--limit"),
         (["--vary", "base_radius=20:120", "--method", "newton"], "--method"),
+        (["--vary", "base_radius=20:120", "--starts", "100000000"], "--starts"),
+        (["--vary", "base_radius=20:120", "--points", "100000000"], "--points"),
+        (["--vary", "base_radius=20:120", "--vary", "cam.base_radius=30:40"], "--vary"),
+        (["--vary", "base_radius=20:120", "--vary", "base_radius=30:40"], "--vary"),
+        (["--vary", "law=cycloidal", "--vary", "motion[0].law=harmonic"], "--vary"),
+        (["--vary", "base_radius=" + ",".join(f"{20 + i / 1000}" for i in range(10_000))], "--vary"),
+        (
+            ["--vary", "law=cycloidal,harmonic", "--vary", "offset=" + ",".join(map(str, range(600)))],
+            "--vary",
+        ),
     ],
-    ids=["unknown-key", "negative", "reversed", "count", "no-segment", "unknown-law", "limit", "method"],
+    ids=[
+        "unknown-key",
+        "negative",
+        "reversed",
+        "count",
+        "no-segment",
+        "unknown-law",
+        "limit",
+        "method",
+        "starts-cap",
+        "points-cap",
+        "same-key-alias",
+        "same-key-twice",
+        "same-segment-law",
+        "10000-choices",
+        "1200-combinations",
+    ],
 )
 def test_bad_options_exit_2_naming_the_flag(args, flag, tmp_path, capsys):
     sample = str(ROOT / "samples" / "offset_roller.toml")
+    start = time.monotonic()
     code = main(["optimize", sample, "--minimize", "base_radius", *args, "-o", str(tmp_path / "o")])
     err = capsys.readouterr().err
+    assert time.monotonic() - start < 30  # refused up front, not after a run
     assert code == 2
     assert err.startswith(f"camcad: error: {flag}:"), err
     assert not (tmp_path / "o").exists()
@@ -283,6 +314,55 @@ def test_infeasible_ranges_exit_3(tmp_path, capsys):
     assert code == 3
     assert "INFEASIBLE" in capsys.readouterr().out
     assert (tmp_path / "optimize.json").exists()
+    optimum = (tmp_path / "optimum.toml").read_text(encoding="utf-8")
+    assert optimum.startswith(
+        "# INFEASIBLE: no design within the ranges meets every limit; this one breaks: "
+    )
+    assert "pressure_angle<=25" in optimum.splitlines()[0]
+    assert main(["check", str(tmp_path / "optimum.toml")]) == 3  # check agrees: a limit is broken
+
+
+def test_an_arm_optimum_typed_back_from_the_screen_passes_check_and_size(tmp_path, capsys):
+    """Issue 31: packaging_rocker over (r_b, d). The printed digits, typed back, give a design that
+    `camcad check` passes; so does optimum.toml; `camcad size` on it finds a radius, and that radius
+    (an independent bracketing search at the optimum's pivot) equals the optimum's r_b: it is minimal."""
+    sample = ROOT / "samples" / "packaging_rocker.toml"
+    vary = ["--vary", "base_radius=20:80", "--vary", "pivot_distance=90:160"]
+    code = main(
+        ["optimize", str(sample), "--minimize", "base_radius", *vary, "-o", str(tmp_path / "o"), "-q"]
+    )
+    printed = capsys.readouterr().out
+    assert code == 0, printed
+    shown = {
+        m["name"]: float(m["value"])
+        for m in re.finditer(r"^  (?P<name>base_radius|pivot_distance) = (?P<value>\S+)$", printed, re.M)
+    }
+    assert set(shown) == {"base_radius", "pivot_distance"}
+    assert "* pressure_angle<=30 (max α)" in printed and "* pressure_angle<=30 (−min α)" in printed
+
+    typed = tomllib.loads(sample.read_text(encoding="utf-8"))
+    typed["cam"]["base_radius"] = shown["base_radius"]
+    typed["follower"]["pivot_distance"] = shown["pivot_distance"]
+    (tmp_path / "typed.toml").write_text(toml_text(typed), encoding="utf-8")
+    assert main(["check", str(tmp_path / "typed.toml")]) == 0
+    assert "all design limits hold" in capsys.readouterr().out
+
+    written = tomllib.loads((tmp_path / "o" / "optimum.toml").read_text(encoding="utf-8"))
+    assert written["cam"]["base_radius"] == shown["base_radius"]
+    assert written["follower"]["pivot_distance"] == shown["pivot_distance"]
+    assert main(["check", str(tmp_path / "o" / "optimum.toml")]) == 0
+    capsys.readouterr()
+    assert main(["size", str(tmp_path / "o" / "optimum.toml")]) == 0
+    assert capsys.readouterr().out.startswith("smallest base radius: ")
+
+    design = load_design(tmp_path / "o" / "optimum.toml")
+    smallest = min_base_radius(
+        Cam.from_design(design),
+        max_pressure_angle=design.cam.max_pressure_angle,
+        min_curvature_radius=design.min_curvature_radius,
+    ).base_radius
+    assert smallest <= shown["base_radius"] + 1e-7
+    assert smallest >= shown["base_radius"] - 1e-3  # no smaller cam at that pivot: the optimum is minimal
 
 
 def test_problem_needs_a_variable():

@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import math
+import os
 import re
+import signal
+import subprocess
+import sys
+import threading
+import time
 from html.parser import HTMLParser
 
 import pytest
@@ -271,11 +278,114 @@ def test_cli_sweep_grid_and_latin_hypercube(tmp_path, capsys):
         (["--grid", "base_radius=40:80:3", "--jobs", "0"], "--jobs"),
         (["--grid", "base_radius=40:80:3", "--limit", "torque<3000"], "--limit"),
         ([], "--grid"),
+        (["--grid", "base_radius=40:80:3", "--seed", "-1"], "--seed"),
+        (["--grid", "base_radius=40:80", "--samples", "3", "--seed", str(2**32)], "--seed"),
+        (["--grid", "base_radius=40:80:3", "--grid", "cam.base_radius=50:60:2"], "--grid"),
+        (["--grid", "offset=0:5:2", "--grid", "offset=1,2"], "--grid"),
+        (["--grid", "base_radius=" + ",".join(f"{40 + i / 1000}" for i in range(10_000))], "--grid"),
     ],
-    ids=["no-count", "unknown-key", "bad-range", "format", "pareto", "jobs", "limit", "no-grid"],
+    ids=[
+        "no-count",
+        "unknown-key",
+        "bad-range",
+        "format",
+        "pareto",
+        "jobs",
+        "limit",
+        "no-grid",
+        "negative-seed",
+        "seed-beyond-32-bits",
+        "same-key-alias",
+        "same-key-twice",
+        "10000-choices",
+    ],
 )
 def test_bad_options_exit_2_naming_the_flag(args, flag, tmp_path, capsys):
     code = main(["sweep", SAMPLE, *args, "-o", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert code == 2
     assert err.startswith(f"camcad: error: {flag}:"), err
+
+
+def _timed_cli(*args: str) -> tuple[float, subprocess.CompletedProcess[str]]:
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    start = time.monotonic()
+    done = subprocess.run(
+        [sys.executable, "-m", "camcad", *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+    return time.monotonic() - start, done
+
+
+@pytest.mark.parametrize(
+    ("address", "words"),
+    [("not a url", "is not a scheduler address"), ("tcp://127.0.0.1:1", "cannot reach the Dask scheduler")],
+    ids=["not-an-address", "refused-port"],
+)
+def test_a_bad_scheduler_fails_fast_with_one_line_and_no_traceback(address, words, tmp_path):
+    """Issue 32: one line, exit 2, within seconds of a run that fails at once on another option; and
+    nothing later (Dask's client finaliser used to print a traceback 40 s on)."""
+    grid = ["--grid", "base_radius=40:80:2", "--format"]
+    baseline, _ = _timed_cli("sweep", SAMPLE, *grid, "xlsx", "-o", str(tmp_path / "b"))  # imports, load
+    seconds, done = _timed_cli(
+        "sweep", SAMPLE, *grid, "csv", "--scheduler", address, "-o", str(tmp_path / "o")
+    )
+    assert done.returncode == 2, done.stderr
+    assert done.stdout == ""
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("camcad: error: --scheduler: "), lines
+    assert words in lines[0]
+    assert "Traceback" not in done.stderr
+    assert seconds < max(10.0, baseline + 5.0), (seconds, baseline)
+    assert not (tmp_path / "o").exists()
+
+
+def _group(pgid: int) -> list[tuple[int, str]]:
+    """(pid, state) of every process of the process group ``pgid``, read from /proc."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat", "rb") as stat:
+                    fields = stat.read().rpartition(b")")[2].split()
+            except OSError:
+                continue
+            if int(fields[2]) == pgid:
+                found.append((int(entry), fields[0].decode()))
+    return found
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads the process table from /proc")
+def test_a_killed_sweep_takes_its_workers_fork_server_and_tracker_with_it(tmp_path):
+    """Issue 32: SIGKILL of `camcad sweep --jobs 2`: within seconds no process of its group is left
+    running (workers, fork server, resource tracker) and the caller's stdout pipe reaches EOF."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    args = ["--grid", "base_radius=40:80:60", "--chunk-size", "1", "--jobs", "2", "--format", "csv"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "camcad", "sweep", SAMPLE, *args, "-o", str(tmp_path / "o"), "-q"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        env=env,
+        start_new_session=True,  # its own process group: everything it starts is found by its id
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while len(_group(proc.pid)) < 5:  # the sweep, the tracker, the fork server and two workers
+            assert proc.poll() is None and time.monotonic() < deadline, _group(proc.pid)
+            time.sleep(0.05)
+        proc.kill()
+        eof = threading.Event()
+        threading.Thread(target=lambda: (proc.stdout.read(), eof.set()), daemon=True).start()
+        assert eof.wait(15), "a process still holds the caller's stdout"
+        deadline = time.monotonic() + 15
+        while [p for p, state in _group(proc.pid) if p != proc.pid and state not in "ZX"]:
+            assert time.monotonic() < deadline, _group(proc.pid)
+            time.sleep(0.1)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=60)

@@ -225,3 +225,52 @@ def test_an_os_error_of_the_move_itself_names_the_output_folder(tmp_path, monkey
         (staging.path / "a.csv").write_text("new")
     assert str(info.value).startswith(f"--output: cannot write {out}: no space left on device; free space")
     assert tree(tmp_path) == before
+
+
+@pytest.fixture
+def other_file_system(tmp_path):
+    """A fresh folder on /dev/shm (tmpfs), when that is another file system than ``tmp_path``'s."""
+    import shutil
+    import tempfile
+
+    shm = Path("/dev/shm")
+    if not shm.is_dir() or not os.access(shm, os.W_OK):
+        pytest.skip("no writable /dev/shm")
+    if os.stat(shm).st_dev == os.stat(tmp_path).st_dev:
+        pytest.skip("/dev/shm is on the same file system as the test's temporary folder")
+    folder = Path(tempfile.mkdtemp(dir=shm, prefix="camcad-test-"))
+    yield folder
+    shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.mark.parametrize("exists", [True, False], ids=["existing-target", "target-made-by-the-build"])
+def test_an_outdir_linked_to_another_file_system_is_staged_beside_its_target(
+    tmp_path, other_file_system, exists
+):
+    """OUTDIR -> /dev/shm/…: the files land in the link's target; the link stays; nothing left anywhere."""
+    target = other_file_system / "real"
+    if exists:
+        target.mkdir()
+        (target / "a.csv").write_text("old")
+    link = tmp_path / "out"
+    link.symlink_to(target, target_is_directory=True)
+    with staged_folder(link) as staging:
+        assert os.stat(staging.path).st_dev == os.stat(other_file_system).st_dev  # beside the target
+        (staging.path / "a.csv").write_text("new")
+        (staging.path / "b.dxf").write_text("new")
+    assert link.is_symlink() and link.resolve() == target.resolve()
+    assert {p.name: p.read_text() for p in target.iterdir()} == {"a.csv": "new", "b.dxf": "new"}
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+    assert [p.name for p in other_file_system.iterdir()] == ["real"]
+
+
+def test_a_failed_build_into_a_linked_outdir_leaves_it_as_it_was(tmp_path, other_file_system):
+    target = other_file_system / "real"
+    target.mkdir()
+    (target / "a.csv").write_text("old")
+    (tmp_path / "out").symlink_to(target, target_is_directory=True)
+    with pytest.raises(RuntimeError), staged_folder(tmp_path / "out") as staging:
+        (staging.path / "a.csv").write_text("half")
+        raise RuntimeError("stage failed")
+    assert {p.name: p.read_text() for p in target.iterdir()} == {"a.csv": "old"}
+    assert [p.name for p in other_file_system.iterdir()] == ["real"]
