@@ -336,7 +336,7 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
     alpha_note = f"limit {k['alpha_limit']:.2f}°"
     if k["alpha_at"] is not None:
         alpha_note += f", at φ = {k['alpha_at']:.1f}°"
-    if abs(k["alpha"]) < 1e-9 and not cam.is_roller and cam.kinematics.guide.pivot is None:
+    if abs(k["alpha"]) < 1e-9 and not cam.has_pitch_curve and cam.kinematics.guide.pivot is None:
         alpha_note = "always 0°: the face is square to its slide"
     rho_note = (
         f"convex profile, at φ = {k['rho_at']:.1f}°"
@@ -344,7 +344,9 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
         else "profile has no convex part"
     )
     if k["rho"] is not None and k["rho"] < 0.0:  # the signed extreme: the profile loops or has a cusp
-        rho_note = f"< 0: the profile {'loops' if cam.is_roller else 'has a cusp'} at φ = {k['rho_at']:.1f}°"
+        rho_note = (
+            f"< 0: the profile {'loops' if cam.has_pitch_curve else 'has a cusp'} at φ = {k['rho_at']:.1f}°"
+        )
     stress_over = (
         k["stress_allowable"] is not None and k["stress"] is not None and k["stress"] > k["stress_allowable"]
     )
@@ -396,14 +398,13 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
             f"{gcode.get('blocks')} blocks",
             f"{gcode.get('arcs')} arcs, about {minutes:.1f} min; {tool}",
         )
-    shown = "°" if cam.follower.kind.oscillating else " mm"
+    lift = cam.follower.kind.lift
+    shown = lift.symbol
     stroke_note = ""
     if k["stroke"] is not None and round(k["stroke"], 3) != round(k["lift"], 3):  # a segment overshoots
         stroke_note = f"nominal; true stroke {k['stroke']:.3f}{shown}"
     cards = [
-        _card(
-            "Arm swing" if cam.follower.kind.oscillating else "Lift", f"{k['lift']:.3f}{shown}", stroke_note
-        ),
+        _card(lift.name, f"{k['lift']:.3f}{shown}", stroke_note),
         _card("Base radius", f"{cam.base_radius:.3f} mm", follower),
         _card("Max pressure angle", f"{k['alpha']:.2f}°", alpha_note, over=alpha_over),
         _card("Min curvature radius", f"{_num(k['rho'], '.3f')} mm", rho_note),
@@ -433,7 +434,7 @@ def _program_table(analysis: Analysis) -> str:
                 _e(law),
             ]
         )
-    lift = "lift [°]" if analysis.cam.follower.kind.oscillating else "lift [mm]"
+    lift = f"lift [{analysis.cam.follower.kind.lift.short}]"
     header = ["#", "segment", "start [°]", "span [°]", lift, "law"]
     return _table(header, rows)
 
@@ -442,11 +443,10 @@ def _design_table(analysis: Analysis) -> str:
     design, cam = analysis.design, analysis.cam
     spec = design.cam
     rows = [
-        ("follower type", design.follower.kind.value),
+        ("follower type", design.follower.kind.word),
         ("base radius [mm]", _num(spec.base_radius)),
         ("follower", _e(cam.kinematics.describe())),
-        ("roller radius [mm]", _num(cam.roller_radius) if cam.is_roller else _DASH),
-        ("follower offset [mm]", _num(cam.eccentricity) if not cam.follower.kind.oscillating else _DASH),
+        *((label, _DASH if value is None else _num(value)) for label, value in cam.kinematics.rows()),
         ("rotation", spec.rotation.value),
         ("speed [rpm]", _num(spec.speed_rpm)),
         ("thickness [mm]", _num(spec.thickness)),
@@ -679,7 +679,7 @@ def compare_table(analyses: Sequence[Analysis]) -> list[list[str]]:
 
 def _lift_unit_text(analyses: Sequence[Analysis]) -> str:
     """The lift's unit of several designs as shown: ``mm`` (slides), ``°`` (arms) or ``mm or °``."""
-    units = {"°" if a.cam.follower.kind.oscillating else "mm" for a in analyses}
+    units = {a.cam.follower.kind.lift.short for a in analyses}
     return units.pop() if len(units) == 1 else "mm or °"
 
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import ast
 import functools
+import re
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
@@ -244,3 +245,103 @@ def test_cycle_finder_finds_a_made_up_cycle():
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a", "d"}, "d": set(), "e": {"e"}}
     assert find_cycles(graph) == {("a", "b", "c"), ("e",)}
     assert find_cycles({"a": {"b"}, "b": {"c"}, "c": set()}) == set()
+
+
+# Follower kinds (issue 33): a follower kind is its module under camcad/geometry/followers/. Nothing
+# else asks which kind it is: no kind flags, no kind enum, no follower-type word in the code.
+
+FOLLOWERS = PACKAGE / "geometry" / "followers"
+FORBIDDEN_ATTRIBUTES = frozenset({"is_roller", "FollowerKind"})  # on anything
+FORBIDDEN_KIND_FLAGS = frozenset({"roller", "oscillating"})  # as ``<...>.kind.roller``, ``kind.oscillating``
+# The type words of the four kinds camcad started with; the registry's words are added at test time.
+KNOWN_FOLLOWER_WORDS = ("translating-roller", "translating-flat", "oscillating-roller", "oscillating-flat")
+
+
+def _docstrings(tree: ast.Module) -> set[int]:
+    """The ids of the docstring constants of a module and its classes and functions."""
+    out: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                out.add(id(body[0].value))
+    return out
+
+
+def follower_kind_uses(tree: ast.Module, words: Iterable[str]) -> list[str]:
+    """Where a module asks which kind of follower it has: kind flags, the kind enum, type words.
+
+    Each as ``line: what``. Docstrings (examples, prose) are not code and are not read.
+    """
+    words = tuple(words)
+    skip = _docstrings(tree)
+    out: list[str] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and node.attr in FORBIDDEN_ATTRIBUTES:
+            out.append(f"{node.lineno}: .{node.attr}")
+        elif isinstance(node, ast.Name) and node.id in FORBIDDEN_ATTRIBUTES:
+            out.append(f"{node.lineno}: {node.id}")
+        elif isinstance(node, ast.alias) and node.name in FORBIDDEN_ATTRIBUTES:
+            out.append(f"{node.lineno}: import {node.name}")
+        elif isinstance(node, ast.Attribute) and node.attr in FORBIDDEN_KIND_FLAGS:
+            owner = node.value
+            name = owner.attr if isinstance(owner, ast.Attribute) else getattr(owner, "id", "")
+            if name == "kind":
+                out.append(f"{node.lineno}: kind.{node.attr}")
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in skip:
+            out += [f"{node.lineno}: {word!r}" for word in words if word in node.value]
+    return out
+
+
+def test_no_follower_kind_is_asked_for_outside_its_module():
+    from camcad.geometry.followers import FOLLOWER_TYPES
+
+    words = sorted({*KNOWN_FOLLOWER_WORDS, *FOLLOWER_TYPES})
+    found = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if FOLLOWERS in path.parents:
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        found += [f"{path.relative_to(ROOT)}:{hit}" for hit in follower_kind_uses(tree, words)]
+    assert not found, "ask the follower's module (its TYPE, its Follower object) instead:\n" + "\n".join(
+        found
+    )
+
+
+def test_follower_kind_scan_flags_a_made_up_module():
+    source = (
+        '"""A docstring may say translating-roller."""\n'
+        "from camcad.geometry.spec import FollowerKind\n"
+        "def f(cam, design):\n"
+        '    """So may this one: oscillating-flat."""\n'
+        "    if cam.is_roller or design.follower.kind.oscillating:\n"
+        '        return f"a {cam.kind.roller} translating-flat"\n'
+        '    return design.follower.kind.word == "oscillating-roller" or FollowerKind\n'
+    )
+    hits = follower_kind_uses(ast.parse(source), KNOWN_FOLLOWER_WORDS)
+    assert sorted(hits) == sorted(
+        [
+            "2: import FollowerKind",
+            "5: .is_roller",
+            "5: kind.oscillating",
+            "6: kind.roller",
+            "6: 'translating-flat'",
+            "7: 'oscillating-roller'",
+            "7: FollowerKind",
+        ]
+    )
+    clean = "def f(cam):\n    return cam.has_pitch_curve and cam.follower.kind.lift.angular\n"
+    assert follower_kind_uses(ast.parse(clean), KNOWN_FOLLOWER_WORDS) == []
+
+
+def test_every_follower_module_is_in_the_registry():
+    """Each module of camcad/geometry/followers/ that declares a TYPE is found; words are unique."""
+    from camcad.geometry.followers import FOLLOWER_TYPES
+
+    declared = [
+        p.stem
+        for p in sorted(FOLLOWERS.glob("*.py"))
+        if not p.stem.startswith("_") and re.search(r"^TYPE = FollowerType\(", p.read_text("utf-8"), re.M)
+    ]
+    assert len(declared) == len(FOLLOWER_TYPES) >= 5
+    assert {k.word.replace("-", "_") for k in FOLLOWER_TYPES.values()} == set(declared)

@@ -8,7 +8,7 @@ from typing import Any
 
 import pytest
 
-from camcad.design import DynamicsModel, FollowerKind, Rotation, load_design, parse_design
+from camcad.design import FOLLOWER_TYPES, DynamicsModel, Rotation, load_design, parse_design
 from camcad.design.schema import _SECTIONS
 from camcad.errors import DesignError
 from tests.conftest import SAMPLES
@@ -83,7 +83,7 @@ def test_a_good_design_converts_units_at_the_edge():
     assert design.cam.max_pressure_angle == pytest.approx(math.radians(25))
     assert design.motion[0].span == pytest.approx(math.radians(150))
     assert design.cam.rotation is Rotation.CCW
-    assert design.follower.kind is FollowerKind.TRANSLATING_ROLLER
+    assert design.follower.kind is FOLLOWER_TYPES["translating-roller"]
     assert design.dynamics.model is DynamicsModel.ENERGY
     assert design.motion[2].law is not None and design.motion[2].law.describe().lower().startswith("dudley")
 

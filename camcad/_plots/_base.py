@@ -95,12 +95,7 @@ def closed(phi_deg: FloatArray, *values: FloatArray) -> tuple[FloatArray, ...]:
 
 def trace_name(analysis: Analysis) -> str:
     """What the follower's reference curve is, in words, for this follower type."""
-    cam = analysis.cam
-    if cam.is_roller:
-        return "pitch curve (roller-centre path)"
-    if cam.kinematics.guide.pivot is not None:
-        return "face trace (point nearest the cam axis)"
-    return "face-centre trace"
+    return analysis.cam.kinematics.words.trace
 
 
 def shape(ax: Axes, patch: Patch) -> None:

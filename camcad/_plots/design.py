@@ -75,14 +75,7 @@ def motion_plot(analysis: Analysis) -> Plot:
     """s, v, a, j (or ψ and its derivatives for an arm) against the cam angle."""
     m = analysis.motion
     phi = np.degrees(m.phi)
-    labels = ("s [mm]", "v = ds/dφ\n[mm/rad]", "a = d²s/dφ²\n[mm/rad²]", "j = d³s/dφ³\n[mm/rad³]")
-    if analysis.cam.follower.kind.oscillating:  # an arm's lift is its swing ψ, in degrees
-        labels = (
-            "arm angle ψ [°]",
-            "ψ′ = dψ/dφ\n[°/rad]",
-            "ψ″ = d²ψ/dφ²\n[°/rad²]",
-            "ψ‴ = d³ψ/dφ³\n[°/rad³]",
-        )
+    labels = analysis.cam.follower.kind.lift.labels  # an arm's lift is its swing ψ, in degrees
     values = (m.s, m.v, m.a, m.j)
     blends = analysis.cam.program.blend_points  # joints solved to match their neighbours (issue 16)
     blend_deg = np.degrees([b.phi for b in blends])
@@ -99,7 +92,7 @@ def motion_plot(analysis: Analysis) -> Plot:
         for k, (label, v) in enumerate(zip(labels, values, strict=True))
     ]
     bounds_deg, segments = _segments(analysis)
-    what = "Arm angle" if analysis.cam.follower.kind.oscillating else "Displacement"
+    what = analysis.cam.follower.kind.lift.title
     blend_note = (
         f"; ticks along the bottom mark the {len(blends)} blend points, where the laws meet continuous "
         + ("to the jerk" if smooth >= 3 else "to the acceleration" if smooth == 2 else f"to order {smooth}")
@@ -160,26 +153,24 @@ def curvature_plot(analysis: Analysis) -> Plot:
     clip = CURVATURE_CLIP * cam.base_radius
     phi = np.degrees(geo.phi)
     curves = [(geo.profile, "cam profile")]
-    if cam.is_roller:  # a flat face's reference trace has no curvature limit of its own
+    circle = cam.has_pitch_curve  # a flat face's reference trace has no curvature limit of its own
+    words = cam.kinematics.words
+    if circle:
         curves.insert(0, (geo.pitch, trace_name(analysis)))
     series = []
     for k, (curve, label) in enumerate(curves):
         rho = np.asarray(curve.rho, dtype=float)
         shown = np.where(np.abs(rho) <= clip, rho, np.nan)  # break the line where ρ leaves the window
-        series.append(_curve(phi, shown, COLORS[k if cam.is_roller else 1], label=f"ρ of the {label}"))
+        series.append(_curve(phi, shown, COLORS[k if circle else 1], label=f"ρ of the {label}"))
     lines = []
-    if cam.is_roller:
-        lines.append(HLine(y=cam.roller_radius, label=f"roller radius {cam.roller_radius:g} mm"))
+    if circle:
+        lines.append(HLine(y=cam.roller_radius, label=f"{words.radius} {cam.roller_radius:g} mm"))
     elif analysis.design.min_curvature_radius > 0.0:
         lines.append(HLine(y=analysis.design.min_curvature_radius, label="smallest allowed ρ"))
     panel = Panel(ylabel="ρ [mm]  (+ convex)", series=series, lines=lines, ylim=(-clip * 1.02, clip * 1.02),
                   height=220.0, legend=True)  # fmt: skip
     bounds_deg, _ = _segments(analysis)
-    why = (
-        "the roller-centre path's convex ρ must stay above the roller radius or the profile loops"
-        if cam.is_roller
-        else "a flat face needs ρ > 0 everywhere (a convex profile) or the face cannot follow it"
-    )
+    why = words.why_rho
     return Plot(
         key="curvature",
         title="Radius of curvature",

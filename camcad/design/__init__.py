@@ -15,10 +15,12 @@ from camcad.design.spec import CamSpec, Design, Dialect, Direction, GcodeSpec
 from camcad.dynamics.spec import DynamicsModel, DynamicsSpec
 from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fit.spec import FitSpec
-from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
+from camcad.geometry.followers import FOLLOWER_TYPES, FollowerType
+from camcad.geometry.spec import FollowerSpec, Rotation
 from camcad.motion.segments import SegmentKind, SegmentSpec
 
 __all__ = [
+    "FOLLOWER_TYPES",
     "CamSpec",
     "Design",
     "Dialect",
@@ -27,8 +29,8 @@ __all__ = [
     "DynamicsModel",
     "DynamicsSpec",
     "FitSpec",
-    "FollowerKind",
     "FollowerSpec",
+    "FollowerType",
     "GcodeSpec",
     "MeshSpec",
     "Rotation",

@@ -44,15 +44,15 @@ from camcad.errors import DesignError
 from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec, PlaneModel
 from camcad.fit.spec import FitSpec
-from camcad.geometry.spec import (
-    CamStyle,
-    ConjugateSpec,
-    FollowerKind,
-    FollowerSpec,
-    GrooveSpec,
-    Rotation,
-    arm_problem,
+from camcad.geometry.followers import (
+    DEFAULT_FOLLOWER,
+    FOLLOWER_TYPES,
+    FollowerKey,
+    FollowerType,
+    follower_keys,
 )
+from camcad.geometry.followers.base import KeyRange
+from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
 from camcad.motion.blend import resolve_blends
 from camcad.motion.laws import LAWS, make_law
 from camcad.motion.program import MotionProgram
@@ -239,6 +239,31 @@ def _mesh_formats(v: list[str]) -> str | None:
     return None
 
 
+_FollowerWord = enum.Enum("_FollowerWord", [(w, w) for w in FOLLOWER_TYPES])  # type: ignore[misc]
+"""The follower types of the registry, as the words the ``type`` rule allows."""
+
+
+def _follower_rule(key: FollowerKey) -> _Rule:
+    """The loader's rule of a key a follower module declares (its range, in the loader's bounds)."""
+    unit = f" {key.unit}"
+    check = {
+        KeyRange.LENGTH: _between(MIN_LENGTH_MM, MAX_LENGTH_MM, unit),
+        KeyRange.LENGTH_OR_ZERO: _between(MIN_LENGTH_MM, MAX_LENGTH_MM, unit, zero=True),
+        KeyRange.NONNEGATIVE: _between(0.0, MAX_LENGTH_MM, unit),
+        KeyRange.SIGNED: _between(-MAX_LENGTH_MM, MAX_LENGTH_MM, unit),
+    }[key.range]
+    return _Rule("float", check=check, attr=key.attr)
+
+
+def _follower_spec(**values: Any) -> FollowerSpec:
+    """The ``[follower]`` table's spec: its kind from the registry, a kind's own keys in ``params``."""
+    word = values.pop("kind", None)
+    kind = DEFAULT_FOLLOWER if word is None else FOLLOWER_TYPES[word.value]
+    attrs = {f.name for f in dataclasses.fields(FollowerSpec)}
+    params = tuple(sorted((k, v) for k, v in values.items() if k not in attrs))
+    return FollowerSpec(kind=kind, params=params, **{k: v for k, v in values.items() if k in attrs})
+
+
 _SECTIONS: dict[str, dict[str, _Rule]] = {
     "cam": {
         "name": _Rule("str", check=_name),
@@ -266,15 +291,9 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "roller_radius": _Rule("float", check=_length),
         "single_plate": _Rule("bool"),
     },
-    "follower": {
-        "type": _Rule("enum", enum=FollowerKind, attr="kind"),
-        "roller_radius": _Rule("float", check=_length_or_zero),
-        "offset": _Rule("float", check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm"), attr="eccentricity"),
-        "face_width": _Rule("float", check=_length),
-        "face_margin": _Rule("float", check=_between(0.0, MAX_LENGTH_MM, " mm")),
-        "pivot_distance": _Rule("float", check=_length),
-        "arm_length": _Rule("float", check=_length),
-        "face_offset": _Rule("float", check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm")),
+    "follower": {  # the keys every follower kind declares in its module (camcad.geometry.followers)
+        "type": _Rule("enum", enum=_FollowerWord, attr="kind"),
+        **{key.name: _follower_rule(key) for key in follower_keys().values()},
     },
     "dynamics": {
         "model": _Rule("enum", enum=DynamicsModel),
@@ -399,9 +418,9 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
     },
 }
 
-_SPEC_CLASSES: dict[str, type] = {
+_SPEC_CLASSES: dict[str, Callable[..., Any]] = {
     "cam": CamSpec,
-    "follower": FollowerSpec,
+    "follower": _follower_spec,
     "dynamics": DynamicsSpec,
     "fit": FitSpec,
     "dxf": DxfSpec,
@@ -770,11 +789,11 @@ def _check_service(design: Design) -> None:
     drive = design.drive
     if drive is None or drive.mode is not DriveMode.SERVO_FOLLOWER:
         return
-    if design.follower.kind.oscillating and drive.screw_lead_mm is not None:
+    if design.follower.kind.lift.angular and drive.screw_lead_mm is not None:
         raise DesignError(
             "drive.screw_lead_mm", "an oscillating follower is driven on its pivot (a rotary axis): no lead"
         )
-    if not design.follower.kind.oscillating and drive.screw_lead_mm is None:
+    if not design.follower.kind.lift.angular and drive.screw_lead_mm is None:
         raise DesignError(
             "drive.screw_lead_mm",
             "is required for mode = 'servo-follower' on a translating follower (mm/rev)",
@@ -794,28 +813,18 @@ def _check_design(design: Design) -> None:
 
 
 def _check_follower(design: Design) -> None:
-    cam, fol = design.cam, design.follower
-    if fol.kind.roller and fol.roller_radius <= 0:
-        raise DesignError(
-            "follower.roller_radius",
-            f"{fol.roller_radius:g} must be > 0 for a {fol.kind.value} follower "
-            f"(allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
-        )
-    if fol.kind is FollowerKind.TRANSLATING_ROLLER:
-        if abs(fol.eccentricity) >= cam.base_radius + fol.roller_radius:
+    """A kind's required lengths > 0, then its module's own check (an arm's triangle and swing, …)."""
+    fol = design.follower
+    for name in fol.kind.required:
+        value = fol.value(name)
+        if value is not None and value <= 0:
             raise DesignError(
-                "follower.offset",
-                f"|{fol.eccentricity:g}| must be smaller than base_radius + roller_radius = "
-                f"{cam.base_radius + fol.roller_radius:g} mm",
+                f"follower.{name}",
+                f"{value:g} must be > 0 for a {fol.kind.word} follower "
+                f"(allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
             )
-    if fol.kind.oscillating:
-        _check_arm(design)
-
-
-def _check_arm(design: Design) -> None:
-    """An oscillating follower's pivot and arm must make a triangle with the cam axis and swing clear."""
-    swing = max(_lift_profile(design.motion))  # degrees
-    problem = arm_problem(design.follower, design.cam.base_radius, swing)
+    swing = max(_lift_profile(design.motion))  # the largest lift, in the kind's lift unit
+    problem = fol.kind.check(fol, design.cam.base_radius, swing)
     if problem is not None:
         raise DesignError(*problem)
 
@@ -841,9 +850,9 @@ def _check_style(design: Design) -> None:
         if cam.outer_radius is not None:
             raise DesignError("cam.outer_radius", "applies to groove cams (cam.style = 'groove') only")
         return
-    if not fol.kind.roller:
+    if not fol.kind.two_sided:
         raise DesignError(
-            "cam.style", f"a {cam.style.value} cam needs a roller follower, not {fol.kind.value}"
+            "cam.style", f"a {cam.style.value} cam needs a roller follower, not {fol.kind.word}"
         )
     if cam.style is CamStyle.GROOVE:
         if cam.outer_radius is None:
@@ -866,7 +875,7 @@ def _check_style(design: Design) -> None:
 def _check_constant_breadth(design: Design) -> None:
     """One plate for both rollers: a radial slide, rollers 180° apart, s(φ + 180°) = lift − s(φ)."""
     fol, conj = design.follower, design.conjugate
-    if fol.kind is not FollowerKind.TRANSLATING_ROLLER or fol.eccentricity != 0.0:
+    if not fol.kind.radial_slide or fol.eccentricity != 0.0:
         raise DesignError(
             "conjugate.single_plate", "a constant-breadth cam needs a translating roller with offset 0"
         )
@@ -933,19 +942,21 @@ def _check_dynamics(design: Design) -> None:
             "dynamics.wire_diameter",
             f"{dyn.wire_diameter:g} mm must be smaller than the mean coil diameter {dyn.coil_diameter:g} mm",
         )
-    if fol.kind.oscillating and (dyn.spring_rate > 0 or dyn.spring_preload != 0) and dyn.spring_arm is None:
+    angular = fol.kind.lift.angular  # an arm: its generalised force is a torque about the pivot
+    if angular and (dyn.spring_rate > 0 or dyn.spring_preload != 0) and dyn.spring_arm is None:
         raise DesignError(
             "dynamics.spring_arm",
             "is required for a linear spring on an oscillating follower (mm, the spring's lever about "
             "the pivot); or give spring_rate_torsional and spring_preload_torsional for a torsion spring",
         )
-    if fol.kind.oscillating and dyn.uses_coil_spring:
+    if angular and dyn.uses_coil_spring:
         raise DesignError(
             "dynamics.wire_diameter", "coil-spring geometry applies to translating followers only"
         )
     if dyn.model is DynamicsModel.GUIDED_TAPPET:
-        if fol.kind is not FollowerKind.TRANSLATING_FLAT:
-            raise DesignError("dynamics.model", "'guided-tappet' needs a translating-flat follower")
+        if not fol.kind.guided_tappet:
+            kinds = " or ".join(k.word for k in FOLLOWER_TYPES.values() if k.guided_tappet)
+            raise DesignError("dynamics.model", f"'guided-tappet' needs a {kinds} follower")
         if dyn.b_m <= dyn.a_m:
             raise DesignError("dynamics.b_m", f"{dyn.b_m:g} mm must be greater than a_m = {dyn.a_m:g} mm")
 
@@ -1038,9 +1049,7 @@ def _check_gcode(design: Design) -> None:
         )
 
 
-# Keys that belong to one family of follower only, and the keys each kind requires.
-_SLIDE_ONLY = ("offset",)
-_ARM_ONLY = ("pivot_distance", "arm_length", "face_offset")
+# Dynamics keys of a follower whose lift is an angle (an arm) only.
 _ARM_DYNAMICS = (
     "arm_inertia",
     "spring_rate_torsional",
@@ -1048,36 +1057,36 @@ _ARM_DYNAMICS = (
     "spring_arm",
     "cg_distance",
 )
-_REQUIRED: dict[FollowerKind, tuple[str, ...]] = {
-    FollowerKind.TRANSLATING_ROLLER: ("roller_radius",),
-    FollowerKind.TRANSLATING_FLAT: (),
-    FollowerKind.OSCILLATING_ROLLER: ("roller_radius", "pivot_distance", "arm_length"),
-    FollowerKind.OSCILLATING_FLAT: ("pivot_distance",),
-}
 
 
-def _check_follower_keys(kind: FollowerKind, follower: Mapping[str, Any], dynamics: Any) -> None:
-    """Each follower kind's required keys present, and no key of the other family."""
-    for key in _REQUIRED[kind]:
-        if key not in follower:
-            raise DesignError(f"follower.{key}", f"is required for a {kind.value} follower (mm)")
-    wrong = _SLIDE_ONLY if kind.oscillating else _ARM_ONLY
-    for key in wrong:
-        if key in follower:
-            family = "translating" if kind.oscillating else "oscillating"
+def _foreign_key(kind: FollowerType, key: str) -> str:
+    """Why ``follower.key``, declared by other kinds, does not apply to ``kind``."""
+    owners = [k for k in FOLLOWER_TYPES.values() if any(fk.name == key for fk in k.keys)]
+    lifts = {k.lift for k in owners}
+    if len(lifts) == 1 and kind.lift not in lifts:
+        return f"applies to {lifts.pop().followers} followers only, not to a {kind.word} follower"
+    if len(owners) == 1:
+        article = "an" if owners[0].word[0] in "aeiou" else "a"
+        return f"applies to {article} {owners[0].word} follower only"
+    return f"applies to {', '.join(k.word for k in owners)} followers only, not to a {kind.word} follower"
+
+
+def _check_follower_keys(kind: FollowerType, follower: Mapping[str, Any], dynamics: Any) -> None:
+    """Each follower kind's required keys present, and no key another kind declares."""
+    declared = {k.name: k for k in kind.keys}
+    for name in kind.required:
+        if name not in follower:
             raise DesignError(
-                f"follower.{key}", f"applies to {family} followers only, not to a {kind.value} follower"
+                f"follower.{name}", f"is required for a {kind.word} follower ({declared[name].unit})"
             )
-    if kind is FollowerKind.OSCILLATING_FLAT and "arm_length" in follower:
-        raise DesignError("follower.arm_length", "applies to an oscillating-roller follower only")
-    if kind is FollowerKind.OSCILLATING_ROLLER and "face_offset" in follower:
-        raise DesignError("follower.face_offset", "applies to an oscillating-flat follower only")
+    for key in follower:
+        if key != "type" and key not in declared:
+            raise DesignError(f"follower.{key}", _foreign_key(kind, key))
     if isinstance(dynamics, Mapping):
         for key in _ARM_DYNAMICS:
-            if key in dynamics and not kind.oscillating:
-                raise DesignError(
-                    f"dynamics.{key}", f"applies to oscillating followers only, not {kind.value}"
-                )
+            if key in dynamics and not kind.lift.angular:
+                arms = next(k.lift.followers for k in FOLLOWER_TYPES.values() if k.lift.angular)
+                raise DesignError(f"dynamics.{key}", f"applies to {arms} followers only, not {kind.word}")
         if "spring_arm" in dynamics and (
             "spring_rate_torsional" in dynamics or "spring_preload_torsional" in dynamics
         ):
@@ -1124,7 +1133,7 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
     folder = Path(source).parent if source else None
     omega = specs["cam"].omega
     motion = tuple(_segment(i, seg, omega=omega, folder=folder) for i, seg in enumerate(raw_motion))
-    motion = _finish_motion(motion, unit="°" if follower.kind.oscillating else " mm")
+    motion = _finish_motion(motion, unit=follower.kind.lift.symbol)
     design = Design(motion=motion, source=source, **specs)
     _check_design(design)
     return design

@@ -22,7 +22,6 @@ from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec
 from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import follower_from_spec
-from camcad.geometry.followers import OscillatingFlat, OscillatingRoller
 from camcad.geometry.groove import roller_flank_offsets
 from camcad.geometry.plate import BoreOutline, Plate
 from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
@@ -91,16 +90,16 @@ class Design:
     def dynamics_setup(self) -> DynamicsSetup:
         """The dynamics stage's options: ``[dynamics]`` with the speed and contact geometry it uses."""
         dyn, cam, fol = self.dynamics, self.cam, self.follower
-        roller = fol.kind.roller
+        module = follower_from_spec(fol, cam.base_radius)
         return DynamicsSetup(
             spec=dyn,
             omega=cam.omega,
             base_radius=cam.base_radius,
             contact_length=dyn.contact_width if dyn.contact_width is not None else cam.thickness,
-            roller_radius=fol.roller_radius if roller else 0.0,
+            roller_radius=module.contact_radius,  # the radius that sets the contact stress; 0: flat
             # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
             tappet_offset=fol.eccentricity if cam.rotation is Rotation.CCW else -fol.eccentricity,
-            arm_angle=_arm_direction(fol, cam.base_radius),
+            arm_angle=module.arm_direction,
             positive_drive=cam.style is not CamStyle.PLATE,
             clearance=self.groove.clearance if cam.style is CamStyle.GROOVE else 0.0,
             flank_offsets=roller_flank_offsets(fol.roller_radius, self.groove.clearance)
@@ -114,15 +113,7 @@ class Design:
 
     @property
     def min_curvature_radius(self) -> float:
-        """Required smallest convex profile radius [mm] (0 roller, 1 flat by default)."""
+        """Required smallest convex profile radius [mm]; by default the follower kind's (0 roller, 1 flat)."""
         if self.cam.min_curvature_radius is not None:
             return self.cam.min_curvature_radius
-        return 0.0 if self.follower.kind.roller else 1.0
-
-
-def _arm_direction(follower: FollowerSpec, base_radius: float) -> float | None:
-    """An oscillating follower's arm direction at ψ = 0 [rad], machine frame; None for a slide."""
-    module = follower_from_spec(follower, base_radius)
-    if isinstance(module, OscillatingRoller | OscillatingFlat):
-        return module.arm_direction
-    return None
+        return self.follower.kind.min_curvature_radius

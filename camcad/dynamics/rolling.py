@@ -99,7 +99,7 @@ def contact_motion(
     tangent = np.asarray(prof.tangent, dtype=float)
     arc = np.hypot(d1[:, 0], d1[:, 1])
     w = np.einsum("ij,ij->i", d1, tangent) * omega  # signed along t (≥ 0 but at a cusp)
-    if cam.is_roller:
+    if cam.kinematics.rolls:
         slip = np.zeros_like(p)
     else:
         sigma = cam.sigma
@@ -124,5 +124,5 @@ def contact_motion(
         slip=slip,
         sliding_speed=sliding,
         entraining_speed=u,
-        rolling=cam.is_roller,
+        rolling=cam.kinematics.rolls,
     )

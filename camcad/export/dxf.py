@@ -420,9 +420,9 @@ def _annotation_lines(cam: Cam, plate: Plate, curves: Sequence[DxfCurve]) -> lis
         if bore.has_keyway:
             sizes += f", keyway {bore.keyway_width:.3f} x {bore.keyway_depth:.3f} mm"
     who = cam.kinematics.describe()
-    if not follower.kind.roller and follower.face_width is not None:
+    if follower.kind.face and follower.face_width is not None:
         who += f", face width {follower.face_width:.3f} mm"
-    who = f"follower {follower.kind.value}: {who}, rotation {cam.rotation.value}"
+    who = f"follower {follower.kind.word}: {who}, rotation {cam.rotation.value}"
     lines = [f"CAM {plate.name}", sizes, who]
     for seg in cam.program.segments:
         span = f"{math.degrees(seg.span):.3f} deg"
@@ -496,7 +496,7 @@ def profile_document(
         reach = max(reach, float(np.max(np.hypot(outline[:, 0], outline[:, 1]))))
     _add_blank(msp, blank_radius)
     reach = max(reach, blank_radius or 0.0)
-    if options.pitch_curve and cam.is_roller:
+    if options.pitch_curve and cam.has_pitch_curve:
         breaks = list(cam.program.pieces)
         pitch = flatten_curve(cam.pitch, options.chord_tolerance, breakpoints=breaks)
         _add_dashes(msp, pitch_dashes(pitch), "PITCH_CURVE")

@@ -26,15 +26,9 @@ from camcad.geometry.envelope import (
     pressure_angle,
     to_cam,
 )
-from camcad.geometry.followers import (
-    Follower,
-    OscillatingFlat,
-    OscillatingRoller,
-    TranslatingFlat,
-    TranslatingRoller,
-)
+from camcad.geometry.followers import Follower
 from camcad.geometry.followers.tied import TiedRoller
-from camcad.geometry.spec import ConjugateSpec, FollowerKind, FollowerSpec, Rotation
+from camcad.geometry.spec import ConjugateSpec, FollowerSpec, Rotation
 from camcad.motion.program import Motion, MotionProgram, Side
 from camcad.motion.segments import SegmentSpec
 
@@ -80,30 +74,8 @@ class _CamDesign(Protocol):
 
 
 def follower_from_spec(spec: FollowerSpec, base_radius: float) -> Follower:
-    """The follower module a design's ``[follower]`` table describes, at base radius r_b [mm]."""
-    if spec.kind is FollowerKind.TRANSLATING_ROLLER:
-        return TranslatingRoller(
-            base_radius=base_radius, roller_radius=spec.roller_radius, eccentricity=spec.eccentricity
-        )
-    if spec.kind is FollowerKind.OSCILLATING_ROLLER:
-        assert spec.pivot_distance is not None and spec.arm_length is not None  # the schema requires them
-        return OscillatingRoller(
-            base_radius=base_radius,
-            roller_radius=spec.roller_radius,
-            pivot_distance=spec.pivot_distance,
-            arm_length=spec.arm_length,
-        )
-    if spec.kind is FollowerKind.OSCILLATING_FLAT:
-        assert spec.pivot_distance is not None  # the schema requires it
-        return OscillatingFlat(
-            base_radius=base_radius,
-            pivot_distance=spec.pivot_distance,
-            face_offset=spec.face_offset,
-            face_width=spec.face_width,
-        )
-    return TranslatingFlat(
-        base_radius=base_radius, eccentricity=spec.eccentricity, face_width=spec.face_width
-    )
+    """The follower module a design's ``[follower]`` table describes, at r_b [mm]: its kind builds it."""
+    return spec.kind.build(spec, base_radius)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -202,13 +174,18 @@ class Cam:
         return replace(self, conjugate=conjugate)
 
     @property
-    def is_roller(self) -> bool:
-        """Whether the follower touches the cam with a roller (r_f > 0)."""
+    def has_pitch_curve(self) -> bool:
+        """Whether the contact element is a circle (a roller, a curved face): its centre traces a pitch curve.
+
+        Then the profile is that path offset inward by :attr:`roller_radius` and
+        undercut makes it loop; a flat face's envelope is the profile itself,
+        and undercut makes a cusp.
+        """
         return self.kinematics.roller_radius > 0.0
 
     @property
     def roller_radius(self) -> float:
-        """r_f [mm]; 0 for a flat follower."""
+        """The contact circle's radius [mm] (a roller's r_f, a curved face's radius); 0 for a flat face."""
         return self.kinematics.roller_radius
 
     @property
@@ -277,7 +254,7 @@ class Cam:
         """The profile, and the follower point that is driven (roller centre or contact), machine frame."""
         base, drho, profile_at = self._base_curve(phi, side)
         profile = offset_curve(base, drho, profile_at)
-        driven = base.point if self.is_roller else profile.point
+        driven = base.point if self.has_pitch_curve else profile.point
         return profile, to_cam(profile.phi, driven, -self.sigma)
 
     def state(self, phi: ArrayLike, *, side: Side = "right") -> CamState:
@@ -319,7 +296,7 @@ class Cam:
         below r_f; +inf where the pitch curve is concave). Flat face: the
         profile radius r_b + s + a (a cusp where it reaches 0).
         """
-        if self.is_roller:
+        if self.has_pitch_curve:
             out: FloatArray = np.where(state.base.rho > 0.0, state.base.rho, np.inf)
             return out
         return state.profile.rho

@@ -272,10 +272,10 @@ def analyse_geometry(
     joints = [bp.phi for bp in cam.program.breakpoints]
     now = cam.state(phi)
     motion, profile, alpha = now.motion, now.profile, now.pressure_angle
-    pitch = now.base if cam.is_roller else cam.pitch(phi)
+    pitch = now.base if cam.has_pitch_curve else cam.pitch(phi)
     findings: list[Finding] = []
 
-    roller = cam.is_roller
+    roller = cam.has_pitch_curve  # a contact circle: undercut loops the profile (else a face's cusp)
     kinds: tuple[Kind, ...] = ("max", "min", "max", "min", "min", "min", "min", "max")
 
     def rows(p: FloatArray, side: Side) -> FloatArray:
@@ -298,7 +298,7 @@ def analyse_geometry(
     if alpha_max.value > max_pressure_angle:
         findings.append(_pressure_finding(phi, alpha, alpha_max, max_pressure_angle))
     face_min = None
-    if not roller:
+    if cam.follower.kind.face:
         check = _face_check if cam.kinematics.guide.pivot is None else _arm_face_check
         face_min, found = check(reach_min, reach_max, face_width, face_margin)
         findings += found
@@ -338,7 +338,7 @@ def analyse_geometry(
         return analysis
     err = undercut_error(analysis, min_curvature_radius=min_curvature_radius)
     undercut_finding = Finding(
-        kind="undercut" if cam.is_roller else "cusp",
+        kind="undercut" if cam.has_pitch_curve else "cusp",
         severity=Severity.HARD,
         field="cam.base_radius",
         message=str(err),
@@ -517,13 +517,14 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
     sized = min_base_radius(cam, min_curvature_radius=min_curvature_radius)
     suggestion = math.ceil(sized.base_radius / _SUGGEST_ROUND_MM) * _SUGGEST_ROUND_MM
     where = format_ranges(list(uc.ranges))
-    if cam.is_roller:
+    if cam.has_pitch_curve:
+        words = cam.kinematics.words
         what = (
             f"undercut at {where}: the pitch curve's convex radius of curvature falls to "
-            f"{uc.worst:.3f} mm {uc.where()}, below the roller radius "
+            f"{uc.worst:.3f} mm {uc.where()}, below the {words.radius} "
             f"{cam.roller_radius:g} mm, so the profile loops"
         )
-        way_out = "or use a smaller roller"
+        way_out = f"or {words.smaller}"
     else:
         what = (
             f"cusp at {where}: the profile radius of curvature "

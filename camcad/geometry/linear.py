@@ -40,6 +40,7 @@ from camcad.extremes import Extreme, Kind, Side, extremes_rows
 from camcad.findings import Finding, Severity
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import PointElement, offset_curve, pressure_angle, translation_envelope
+from camcad.geometry.followers import FOLLOWER_TYPES
 from camcad.geometry.followers.base import Follower
 from camcad.motion.program import Motion, MotionProgram
 
@@ -84,7 +85,7 @@ def _roller(follower: Follower, options: LinearOptions) -> float:
         raise DesignError(
             "follower.type",
             "a flat face has no envelope on a linear cam (it does not turn relative to the plate); "
-            "use translating-roller or oscillating-roller",
+            f"use {' or '.join(t.word for t in FOLLOWER_TYPES.values() if t.two_sided)}",
         )
     return follower.roller_radius
 

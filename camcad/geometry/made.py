@@ -184,7 +184,7 @@ def made_motion(
 
     phi_all = ph.ravel() if own else np.tile(ph, nv)
     phase = per_point(Tol.PHASE)
-    w = per_point(Tol.FORM) + (per_point(Tol.ROLLER_RADIUS) if mount0.is_roller else 0.0)
+    w = per_point(Tol.FORM) + (per_point(Tol.ROLLER_RADIUS) if mount0.has_circle else 0.0)
     mounts = _mount_arrays(mount0, {t: per_point(t) for t in Tol})
     sigma = mount0.sigma
     angle = sigma * (phi_all - phase)  # the cam's turn: R(σ(φ − δ))
@@ -257,7 +257,7 @@ def _condition(
     """g(u) = 0 at the contact, and dg/du (see the module notes)."""
     y = _turn(curve.x, angle)
     y_u = _turn(curve.d1, angle)
-    if mount.is_roller:
+    if mount.has_circle:
         if mount.axis is not None:
             a_perp = np.array([mount.axis[1], -mount.axis[0]])
             return _dot(y - mounts.origin, a_perp), _dot(y_u, a_perp)
@@ -283,7 +283,7 @@ def _kinematics(
     n = _turn(curve.normal, angle)
     n_u = y_u * curve.curvature[:, None]
     nan = np.full(y.shape[0], np.nan)
-    if mount.is_roller:
+    if mount.has_circle:
         if mount.axis is not None:
             a = np.asarray(mount.axis)
             a_perp = np.array([a[1], -a[0]])

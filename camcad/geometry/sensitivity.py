@@ -120,8 +120,8 @@ class Mount:
     face_offset: float = 0.0
 
     @property
-    def is_roller(self) -> bool:
-        """Whether the follower touches with a roller (else a face)."""
+    def has_circle(self) -> bool:
+        """Whether the contact element is a circle of ``roller_radius`` (a roller, a curved face)."""
         return self.roller_radius > 0.0
 
     @property
@@ -160,13 +160,13 @@ class Mount:
 def applicable(mount: Mount) -> tuple[Tol, ...]:
     """The tolerances that mean something for this follower, in :class:`Tol` order."""
     out = [Tol.FORM]
-    if mount.is_roller:
+    if mount.has_circle:
         out.append(Tol.ROLLER_RADIUS)
     if mount.axis is not None:
         out += [Tol.ECCENTRICITY, Tol.CENTRE_DISTANCE]
     else:
         out += [Tol.CENTRE_DISTANCE, Tol.PIVOT_X, Tol.PIVOT_Y]
-        out.append(Tol.ARM_LENGTH if mount.is_roller else Tol.FACE_OFFSET)
+        out.append(Tol.ARM_LENGTH if mount.has_circle else Tol.FACE_OFFSET)
     out.append(Tol.PHASE)
     return tuple(out)
 
@@ -290,7 +290,7 @@ def pressure_angle_identity(mount: Mount, q: ArrayLike, v: ArrayLike) -> FloatAr
     if mount.axis is not None:
         a = np.asarray(mount.axis, dtype=float)
         a_perp = np.array([a[1], -a[0]])
-        if not mount.is_roller:  # a face square to its slide: α ≡ 0 (complex zeros under the complex step)
+        if not mount.has_circle:  # a face square to its slide: α ≡ 0 (complex zeros under the complex step)
             flat: FloatArray = 0.0 * qa * va
             return flat
         centre = np.asarray(mount.origin) + qa[..., None] * a
@@ -302,7 +302,7 @@ def pressure_angle_identity(mount: Mount, q: ArrayLike, v: ArrayLike) -> FloatAr
         p = np.asarray(mount.pivot)
         omega = mount.turn * va
         inst = (omega / (omega - mount.sigma))[..., None] * p
-        if mount.is_roller:
+        if mount.has_circle:
             theta = mount.theta0 + mount.turn * qa
             contact = p + mount.arm_length * np.stack((np.cos(theta), np.sin(theta)), axis=-1)
             n = contact - inst

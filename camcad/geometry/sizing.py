@@ -11,7 +11,6 @@ from camcad._typing import FloatArray
 from camcad.errors import DesignError
 from camcad.extremes import Extreme, Side, extremes_rows
 from camcad.geometry.cam import Cam
-from camcad.geometry.spec import arm_problem
 
 __all__ = ["SizingResult", "feasible_margins", "min_base_radius", "min_pivot_distance"]
 
@@ -103,7 +102,7 @@ def min_base_radius(
     is returned.
     """
     phi = cam.sample_phi(step)
-    if cam.follower.kind.oscillating:
+    if cam.kinematics.guide.pivot is not None:  # an arm
         return _arm_search(cam, phi, "base_radius", max_pressure_angle, min_curvature_radius)
     lo = max(abs(cam.eccentricity) - cam.roller_radius, 0.0) + _RADIUS_TOL_MM
 
@@ -174,7 +173,7 @@ def min_pivot_distance(
 
     See :func:`min_base_radius` for the limits and :func:`_arm_search` for the search.
     """
-    if not cam.follower.kind.oscillating:
+    if cam.kinematics.guide.pivot is None:
         raise DesignError("follower.type", "sizing the pivot distance needs an oscillating follower")
     return _arm_search(cam, cam.sample_phi(step), "pivot_distance", max_pressure_angle, min_curvature_radius)
 
@@ -186,7 +185,7 @@ def _arm_search(cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min:
     dwell is atan((d·cos β − l)/(d·sin β)), zero at one geometry and growing on
     both sides of it), so the feasible set need not be a half-line: the search
     scans the admissible range (the arm reaches the base circle and swings
-    clear, :func:`camcad.geometry.spec.arm_problem`) on a grid of
+    clear, the follower kind's ``check``) on a grid of
     ``_SCAN_POINTS`` and the design's own value, and bisects to 1e-7 mm between
     the last infeasible and the first feasible grid value. Feasible sets
     narrower than the grid step are not found unless they hold the design's
@@ -216,7 +215,7 @@ def _arm_search(cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min:
             if knob == "base_radius"
             else replace(cam, follower=replace(fol, pivot_distance=x))
         )
-        if arm_problem(trial.follower, trial.base_radius, swing) is not None:
+        if trial.follower.kind.check(trial.follower, trial.base_radius, swing) is not None:
             return None
         return trial
 

@@ -117,9 +117,8 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
     spec = analysis.design.dynamics
     phi = np.asarray(geo.phi)
     index = np.unique(np.linspace(0, len(phi) - 1, min(CURVE_POINTS, len(phi))).round().astype(int))
-    arm = cam.follower.kind.oscillating
-    u = "°" if arm else "mm"
-    x = "ψ" if arm else "s"
+    lift = cam.follower.kind.lift
+    u, x = lift.short, lift.variable
     limit = math.degrees(geo.max_pressure_angle)
     clip = CURVATURE_CLIP * cam.base_radius
 
@@ -127,12 +126,12 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
         return [{"label": label, "y": _series(values, index, bound)}]
 
     rho = one("cam profile", geo.profile.rho, clip)
-    if cam.is_roller:
-        rho = one("roller-centre path", geo.pitch.rho, clip) + rho
-    roller = [cam.roller_radius] if cam.is_roller else []
+    if cam.has_pitch_curve:
+        rho = one(cam.kinematics.words.path, geo.pitch.rho, clip) + rho
+    roller = [cam.roller_radius] if cam.has_pitch_curve else []
     stress_limits = [] if spec.allowable_stress is None else [spec.allowable_stress]
     charts = [
-        _chart("s", "Arm angle ψ" if arm else "Displacement s", u, one("s", m.s), []),
+        _chart("s", f"{lift.title} {x}", u, one("s", m.s), []),
         _chart("v", "Velocity d" + x + "/dφ", f"{u}/rad", one("v", m.v), []),
         _chart("a", "Acceleration d²" + x + "/dφ²", f"{u}/rad²", one("a", m.a), []),
         _chart("j", "Jerk d³" + x + "/dφ³", f"{u}/rad³", one("j", m.j), []),
@@ -179,7 +178,7 @@ def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
         "drawing": _drawing(analysis),
         "phi_deg": phi_deg,
         "charts": charts,
-        "lift_unit": "°" if analysis.cam.follower.kind.oscillating else "mm",
+        "lift_unit": analysis.cam.follower.kind.lift.short,
         "summary": {k: summary[k] for k in ("motion", "geometry", "dynamics") if k in summary},
         "findings": [f.summary() for f in analysis.findings],
     }

@@ -16,8 +16,9 @@ from scipy.optimize import minimize_scalar
 
 from camcad.geometry.cam import Cam
 from camcad.geometry.envelope import to_cam
+from camcad.geometry.followers import FOLLOWER_TYPES
 from camcad.geometry.sizing import feasible_margins, min_base_radius, min_pivot_distance
-from camcad.geometry.spec import FollowerKind, FollowerSpec, Rotation
+from camcad.geometry.spec import FollowerSpec, Rotation
 from camcad.motion.laws import make_law
 from camcad.motion.program import MotionProgram
 from camcad.motion.segments import SegmentKind, SegmentSpec
@@ -41,13 +42,13 @@ def program(lift: float, *, rise: float = 120.0, back: float = 120.0) -> MotionP
 
 def roller_cam(rotation: Rotation, *, d: float = 120.0, arm: float = 90.0, lift: float = 20.0) -> Cam:
     spec = FollowerSpec(
-        kind=FollowerKind.OSCILLATING_ROLLER, roller_radius=15.0, pivot_distance=d, arm_length=arm
+        kind=FOLLOWER_TYPES["oscillating-roller"], roller_radius=15.0, pivot_distance=d, arm_length=arm
     )
     return Cam(program=program(lift), base_radius=50.0, follower=spec, rotation=rotation)
 
 
 def flat_cam(rotation: Rotation, *, f: float = 5.0) -> Cam:
-    spec = FollowerSpec(kind=FollowerKind.OSCILLATING_FLAT, pivot_distance=130.0, face_offset=f)
+    spec = FollowerSpec(kind=FOLLOWER_TYPES["oscillating-flat"], pivot_distance=130.0, face_offset=f)
     return Cam(program=program(10.0), base_radius=40.0, follower=spec, rotation=rotation)
 
 
@@ -174,7 +175,7 @@ def test_a_very_long_arm_becomes_a_slide(rotation: Rotation) -> None:
         start = np.array([0.0, 65.0])
         u = -np.array([-(start - k.pivot)[1], (start - k.pivot)[0]]) / arm  # driven direction at ψ = 0
         e = -float(start @ np.array([-u[1], u[0]]))  # distance of the slide's line from the axis
-        spec = FollowerSpec(kind=FollowerKind.TRANSLATING_ROLLER, roller_radius=15.0, eccentricity=e)
+        spec = FollowerSpec(kind=FOLLOWER_TYPES["translating-roller"], roller_radius=15.0, eccentricity=e)
         slide = Cam(program=program(lift), base_radius=50.0, follower=spec, rotation=rotation)
         a, b = rocker.state(PHI), slide.state(PHI)
         errors.append(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -10,7 +11,24 @@ from camcad._typing import FloatArray
 from camcad.geometry.envelope import PointElement
 from camcad.motion.program import Motion
 
-__all__ = ["arm_swing", "turning_point"]
+if TYPE_CHECKING:
+    from camcad.geometry.spec import FollowerSpec
+
+__all__ = ["arm_swing", "pivot_problem", "turning_point"]
+
+
+def pivot_problem(spec: FollowerSpec, base_radius: float) -> tuple[str, str] | None:
+    """Why an arm's pivot cannot be: missing, or inside the base circle (field path, message); or None."""
+    d = spec.pivot_distance
+    if d is None:
+        return ("follower.pivot_distance", f"is required for a {spec.kind.word} follower (mm)")
+    if d <= base_radius:
+        return (
+            "follower.pivot_distance",
+            f"{d:g} mm puts the pivot inside the base circle; allowed: > base_radius = {base_radius:g} mm",
+        )
+    return None
+
 
 ArmAngles = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
 

@@ -4,16 +4,37 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, LineElement, PointElement
-from camcad.geometry.followers._arm import arm_swing
-from camcad.geometry.followers.base import FollowerSketch
+from camcad.geometry.followers._arm import arm_swing, pivot_problem
+from camcad.geometry.followers.base import (
+    ARM_LIFT,
+    FACE_MARGIN,
+    FACE_WIDTH,
+    PIVOT_DISTANCE,
+    FollowerKey,
+    FollowerSketch,
+    FollowerType,
+    KeyRange,
+    Problem,
+    Words,
+)
 from camcad.motion.program import Motion
 
-__all__ = ["OscillatingFlat"]
+if TYPE_CHECKING:
+    from camcad.geometry.spec import FollowerSpec
+
+__all__ = ["FACE_OFFSET", "TYPE", "OscillatingFlat"]
+
+FACE_OFFSET = FollowerKey(
+    name="face_offset",
+    range=KeyRange.SIGNED,
+    description="the face line's distance f from the pivot (mm), + when the pivot is on the follower's side",
+)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -131,3 +152,75 @@ class OscillatingFlat:
                 )
             )
         return out
+
+    @property
+    def contact_radius(self) -> float:
+        """0: a flat face."""
+        return 0.0
+
+    @property
+    def rolls(self) -> bool:
+        """False: the face slides on the cam."""
+        return False
+
+    @property
+    def words(self) -> Words:
+        """A face on an arm: its reference curve is the face's point nearest the cam axis."""
+        return Words(trace="face trace (point nearest the cam axis)")
+
+    def rows(self) -> tuple[tuple[str, float | None], ...]:
+        """Neither a roller nor an offset."""
+        return (("roller radius [mm]", None), ("follower offset [mm]", None))
+
+
+def _build(spec: FollowerSpec, base_radius: float) -> OscillatingFlat:
+    assert spec.pivot_distance is not None  # the schema requires it
+    return OscillatingFlat(
+        base_radius=base_radius,
+        pivot_distance=spec.pivot_distance,
+        face_offset=spec.face_offset,
+        face_width=spec.face_width,
+    )
+
+
+def _check(spec: FollowerSpec, base_radius: float, swing: float) -> Problem:
+    """The face must touch the base circle (|r_b + f| < d) and turn less than the angle that squares it.
+
+    ``swing`` is the largest ψ [degrees]; past 90° − atan2(r_b + f, √(d² − (r_b + f)²))
+    the face is square to the line pivot → cam axis and would approach the cam again.
+    """
+    problem = pivot_problem(spec, base_radius)
+    if problem is not None:
+        return problem
+    d = spec.pivot_distance
+    assert d is not None
+    y = base_radius + spec.face_offset
+    if abs(y) >= d:
+        return (
+            "follower.face_offset",
+            f"{spec.face_offset:g} mm: the face cannot touch the base circle from a pivot {d:g} mm "
+            f"away; allowed: |base_radius + face_offset| < pivot_distance",
+        )
+    start = 90.0 - math.degrees(math.atan2(y, math.sqrt(d * d - y * y)))
+    if swing >= start:
+        return (
+            "motion",
+            f"the face swings {swing:g}° but turns square to the line pivot → cam axis after "
+            f"{start:.2f}° (it would approach the cam again); allowed: a largest lift below {start:.2f}°",
+        )
+    return None
+
+
+TYPE = FollowerType(
+    word="oscillating-flat",
+    order=4,
+    keys=(PIVOT_DISTANCE, FACE_OFFSET, FACE_WIDTH, FACE_MARGIN),
+    required=("pivot_distance",),
+    lift=ARM_LIFT,
+    face=True,
+    two_sided=False,
+    min_curvature_radius=1.0,
+    build=_build,
+    check=_check,
+)
+"""``type = "oscillating-flat"``: a flat face on a swinging arm; its lift is the arm's swing in degrees."""

@@ -4,16 +4,33 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, PointElement
-from camcad.geometry.followers._arm import arm_swing, turning_point
-from camcad.geometry.followers.base import FollowerSketch, circle_points
+from camcad.geometry.followers._arm import arm_swing, pivot_problem, turning_point
+from camcad.geometry.followers.base import (
+    ARM_LIFT,
+    PIVOT_DISTANCE,
+    ROLLER_RADIUS,
+    ROLLER_WORDS,
+    FollowerKey,
+    FollowerSketch,
+    FollowerType,
+    Problem,
+    Words,
+    circle_points,
+)
 from camcad.motion.program import Motion
 
-__all__ = ["OscillatingRoller"]
+if TYPE_CHECKING:
+    from camcad.geometry.spec import FollowerSpec
+
+__all__ = ["ARM_LENGTH", "TYPE", "OscillatingRoller"]
+
+ARM_LENGTH = FollowerKey(name="arm_length", description="arm length l, pivot to roller centre (mm)")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -113,3 +130,78 @@ class OscillatingRoller:
                 )
             )
         return out
+
+    @property
+    def contact_radius(self) -> float:
+        """r_f [mm]: the roller's radius sets the contact stress."""
+        return self.roller_radius
+
+    @property
+    def rolls(self) -> bool:
+        """True: a roller turning on its bearing."""
+        return True
+
+    @property
+    def words(self) -> Words:
+        """A roller's names."""
+        return ROLLER_WORDS
+
+    def rows(self) -> tuple[tuple[str, float | None], ...]:
+        """Roller radius; no offset on an arm."""
+        return (("roller radius [mm]", self.roller_radius), ("follower offset [mm]", None))
+
+
+def _build(spec: FollowerSpec, base_radius: float) -> OscillatingRoller:
+    assert spec.pivot_distance is not None and spec.arm_length is not None  # the schema requires them
+    return OscillatingRoller(
+        base_radius=base_radius,
+        roller_radius=spec.roller_radius,
+        pivot_distance=spec.pivot_distance,
+        arm_length=spec.arm_length,
+    )
+
+
+def _check(spec: FollowerSpec, base_radius: float, swing: float) -> Problem:
+    """The arm must reach the roller's start on the base circle and not swing past the line pivot → cam axis.
+
+    |d − l| ≤ r_b + r_f ≤ d + l, and β0 + ψ < 180° (after which the roller
+    would come back towards the cam); ``swing`` is the largest ψ [degrees].
+    """
+    problem = pivot_problem(spec, base_radius)
+    if problem is not None:
+        return problem
+    d, arm = spec.pivot_distance, spec.arm_length
+    assert d is not None
+    if arm is None:
+        return ("follower.arm_length", f"is required for an {spec.kind.word} follower (mm)")
+    r0 = base_radius + spec.roller_radius
+    if abs(d - arm) > r0 or d + arm < r0:
+        return (
+            "follower.arm_length",
+            f"{arm:g} mm cannot reach the roller's start on the base circle: with pivot_distance "
+            f"{d:g} mm the arm must be between |d − (r_b + r_f)| = {abs(d - r0):g} mm and "
+            f"d + r_b + r_f = {d + r0:g} mm",
+        )
+    beta0 = math.degrees(math.acos(max(-1.0, min(1.0, (d * d + arm * arm - r0 * r0) / (2.0 * d * arm)))))
+    if beta0 + swing >= 180.0:
+        return (
+            "motion",
+            f"the arm swings {swing:g}° from its start at {beta0:.2f}° off the line pivot → cam "
+            f"axis, past 180°: the roller would swing back towards the cam axis; allowed: a "
+            f"largest lift below {180.0 - beta0:.2f}°",
+        )
+    return None
+
+
+TYPE = FollowerType(
+    word="oscillating-roller",
+    order=3,
+    keys=(ROLLER_RADIUS, PIVOT_DISTANCE, ARM_LENGTH),
+    required=("roller_radius", "pivot_distance", "arm_length"),
+    lift=ARM_LIFT,
+    face=False,
+    two_sided=True,
+    build=_build,
+    check=_check,
+)
+"""``type = "oscillating-roller"``: a roller on a swinging arm; its lift is the arm's swing in degrees."""

@@ -9,7 +9,7 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, PointElement
-from camcad.geometry.followers.base import Follower, FollowerSketch, circle_points
+from camcad.geometry.followers.base import ROLLER_WORDS, Follower, FollowerSketch, Words, circle_points
 from camcad.motion.program import Motion
 
 __all__ = ["TiedRoller"]
@@ -125,3 +125,27 @@ class TiedRoller:
                 )
             )
         return out
+
+    @property
+    def contact_radius(self) -> float:
+        """r_f2 [mm]: the second roller's radius sets its plate's contact stress."""
+        return self.roller_radius
+
+    @property
+    def rolls(self) -> bool:
+        """True: a roller turning on its bearing."""
+        return True
+
+    @property
+    def arm_direction(self) -> float | None:
+        """The first follower's: the pair moves as one."""
+        return self.first.arm_direction
+
+    @property
+    def words(self) -> Words:
+        """A roller's names."""
+        return ROLLER_WORDS
+
+    def rows(self) -> tuple[tuple[str, float | None], ...]:
+        """The second roller's radius, and the first follower's offset."""
+        return (("roller radius [mm]", self.roller_radius), *self.first.rows()[1:])

@@ -4,15 +4,30 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, LineElement, PointElement
-from camcad.geometry.followers.base import FollowerSketch, slide_point, slide_sketch
+from camcad.geometry.followers.base import (
+    FACE_MARGIN,
+    FACE_WIDTH,
+    OFFSET,
+    SLIDE_LIFT,
+    FollowerSketch,
+    FollowerType,
+    Words,
+    no_problem,
+    slide_point,
+    slide_sketch,
+)
 from camcad.motion.program import Motion
 
-__all__ = ["TranslatingFlat"]
+if TYPE_CHECKING:
+    from camcad.geometry.spec import FollowerSpec
+
+__all__ = ["TYPE", "TranslatingFlat"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -66,3 +81,49 @@ class TranslatingFlat:
         centres = self.trace(motion).m0
         axis = np.array([0.0, 1.0])
         return [slide_sketch(c, axis, radius=0.0, half_face=half, size=size) for c in centres]
+
+    @property
+    def contact_radius(self) -> float:
+        """0: a flat face."""
+        return 0.0
+
+    @property
+    def rolls(self) -> bool:
+        """False: the face slides on the cam."""
+        return False
+
+    @property
+    def arm_direction(self) -> None:
+        """None: a slide."""
+        return None
+
+    @property
+    def words(self) -> Words:
+        """A face on a slide: its reference curve is the face centre's path."""
+        return Words(trace="face-centre trace")
+
+    def rows(self) -> tuple[tuple[str, float | None], ...]:
+        """No roller; the offset."""
+        return (("roller radius [mm]", None), ("follower offset [mm]", self.eccentricity))
+
+
+def _build(spec: FollowerSpec, base_radius: float) -> TranslatingFlat:
+    return TranslatingFlat(
+        base_radius=base_radius, eccentricity=spec.eccentricity, face_width=spec.face_width
+    )
+
+
+TYPE = FollowerType(
+    word="translating-flat",
+    order=2,
+    keys=(OFFSET, FACE_WIDTH, FACE_MARGIN),
+    required=(),
+    lift=SLIDE_LIFT,
+    face=True,
+    two_sided=False,
+    guided_tappet=True,
+    min_curvature_radius=1.0,
+    build=_build,
+    check=no_problem,
+)
+"""``type = "translating-flat"``: a flat face square to a slide (a tappet)."""
