@@ -104,7 +104,7 @@ def test_contact_force_balances_the_moment_about_the_pivot(kind: str, rotation: 
         - dyn.follower_mass * STANDARD_GRAVITY * dyn.cg_distance * np.cos(theta0 - psi)
     )
     # the force acts along the profile normal through the contact (or the roller centre)
-    point = to_cam(m.phi, st.base.point if cam.is_roller else st.profile.point, -cam.sigma)
+    point = to_cam(m.phi, st.base.point if cam.has_pitch_curve else st.profile.point, -cam.sigma)
     normal = to_cam(m.phi, st.profile.normal, -cam.sigma)
     arm = point - np.asarray(cam.kinematics.guide.pivot)
     lever = -(arm[:, 0] * normal[:, 1] - arm[:, 1] * normal[:, 0])  # a rise turns the arm clockwise
@@ -155,8 +155,8 @@ def test_a_linear_spring_at_a_lever_is_a_torsion_spring() -> None:
 def _raw(design: Design) -> dict[str, Any]:
     """The mapping rocker() built ``design`` from (rebuilt from its fields)."""
     fol, dyn = design.follower, design.dynamics
-    follower: dict[str, Any] = {"type": fol.kind.value, "pivot_distance": fol.pivot_distance}
-    if fol.kind.roller:
+    follower: dict[str, Any] = {"type": fol.kind.word, "pivot_distance": fol.pivot_distance}
+    if fol.kind.word == "oscillating-roller":
         follower |= {"roller_radius": fol.roller_radius, "arm_length": fol.arm_length}
     else:
         follower |= {"face_offset": fol.face_offset}

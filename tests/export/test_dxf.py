@@ -183,7 +183,7 @@ def test_annotation_is_plain_text(case, written):
     joined = "\n".join(texts)
     assert design.cam.name in joined
     assert f"base radius {design.cam.base_radius:.3f} mm" in joined
-    assert design.follower.kind.value in joined
+    assert design.follower.kind.word in joined
     for seg in design.motion:
         if seg.law is not None:
             assert seg.law.describe() in joined
@@ -198,7 +198,7 @@ def test_centre_lines_and_pitch_curve(case, written):
     assert len(lines) == 2
     assert all(line.dxf.start.isclose(-line.dxf.end) for line in lines)  # through the cam axis
     pitch = msp.query('*[layer=="PITCH_CURVE"]')
-    if not cam.is_roller:
+    if not cam.has_pitch_curve:
         assert len(pitch) == 0
         return
     # dashed by geometry: open degree-1 SPLINEs (OpenSCAD skips SPLINE; it closed open polylines into

@@ -136,7 +136,7 @@ def test_pitch_curve_prints_dashed_in_colour_and_monochrome(built: Built, tmp_pa
     """
     import ezdxf
 
-    if not built.cam.is_roller or not built.design.dxf.pitch_curve:
+    if not built.cam.has_pitch_curve or not built.design.dxf.pitch_curve:
         pytest.skip("no pitch curve: not a roller follower")
     dashes = len(ezdxf.readfile(built.dxf).modelspace().query('SPLINE[layer=="PITCH_CURVE"]'))
     colour = paths_by_colour(dxf2pdf(built.dxf, tmp_path / "colour"))
