@@ -334,7 +334,8 @@ class Result:
         (°, with ``pressure_angle_limit``), ``min_curvature_radius`` (mm,
         smallest convex), ``min_concave_radius`` (mm), ``max_torque``
         (N·mm), ``max_contact_force``, ``min_contact_force`` (N),
-        ``max_contact_stress`` (MPa, Hertz), ``fit_max_error`` (mm); and
+        ``max_contact_stress`` (MPa, Hertz), ``fit_max_error`` (mm),
+        ``max_von_mises`` (MPa, the finite-element check; None without it); and
         ``undercut``, ``follower_jump`` (bool; None for a positive drive),
         ``fit_control_points`` (int or None).
     Curves (read-only float64 arrays over the same angles, shape (n,))
@@ -373,6 +374,10 @@ class Result:
         self.follower_jump: bool | None = None if positive else dyn.get("jump")
         self.fit_control_points: int | None = None if fit is None else int(fit["control_points"])
         self.fit_max_error = Quantity(value=None if fit is None else float(fit["max_error_mm"]), unit="mm")
+        fea = summary.get("fea") or {}
+        self.max_von_mises = Quantity(
+            value=fea.get("von_mises_max_MPa"), unit="MPa", angle_deg=fea.get("von_mises_max_angle_deg")
+        )
         geometry, dynamics, m = analysis.geometry, analysis.dynamics, analysis.motion
         self.phi = _readonly(geometry.phi)
         self.angle_deg = _readonly(np.degrees(geometry.phi))
