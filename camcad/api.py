@@ -47,7 +47,7 @@ from camcad.findings import Finding
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
+    import tomli as tomllib  # type: ignore[import-not-found, unused-ignore]
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -150,7 +150,7 @@ class Design:
         """Write the design's files into ``outdir``, as ``camcad build`` does; see :meth:`Result.build`."""
         from camcad.pipeline import build
 
-        return build(self._spec, outdir, only=only)
+        return build(self._spec, Path(outdir), only=only)
 
     def _preview(self) -> Analysis:
         """The geometry and dynamics without fit or toolpath (for the drawing), computed once."""
@@ -700,4 +700,4 @@ def sweep(
         sampling="grid" if counted else f"Latin hypercube, seed {seed}",
         chunk_size=chunk_size,
     )
-    return run(plan, outdir, fmt=fmt, jobs=jobs, scheduler=scheduler)
+    return run(plan, Path(outdir), fmt=fmt, jobs=jobs, scheduler=scheduler)

@@ -44,7 +44,8 @@ LAYER_ORDER: tuple[frozenset[str], ...] = (
     frozenset({"analysis", "positive", "report", "report_tables", "_plots"}),
     frozenset({"pipeline"}),
     frozenset({"explore"}),  # camcad/explore/ (issue 20): optimise, sweep, Pareto; analyses through pipeline
-    frozenset({"cli", "serve", "api", "__init__", "__main__"}),  # api: the Python API (issue 39); serve/ (issue 19): the live designer
+    # serve/ (issue 19): the live designer; api: the Python API (issue 39)
+    frozenset({"cli", "serve", "api", "__init__", "__main__"}),
 )
 LAYERS: dict[str, int] = {name: rank for rank, names in enumerate(LAYER_ORDER) for name in names}
 DESIGN_READERS_FROM = LAYERS["analysis"]  # this layer and those above may import design
