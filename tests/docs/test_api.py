@@ -61,6 +61,12 @@ def shown(q: camcad.Quantity, digits: int, unit: str) -> str:
     return text
 
 
+@pytest.fixture(scope="module")
+def offset() -> camcad.Result:
+    """The offset roller sample, analysed once for the tests that only read it."""
+    return camcad.analyse(camcad.load(OFFSET), toolpath=False)
+
+
 def yes_no(value: bool | None) -> str:
     return "—" if value is None else ("yes" if value else "no")
 
@@ -97,9 +103,9 @@ def test_a_full_analysis_has_the_checks_findings_and_verdict(capsys):
     assert result.ok == (code == 0)
 
 
-def test_extremes_are_at_least_the_sampled_curves():
+def test_extremes_are_at_least_the_sampled_curves(offset):
     """The figures are true extremes: never below the largest sample of the curves (independent arrays)."""
-    result = camcad.analyse(camcad.load(OFFSET), toolpath=False)
+    result = offset
     tol = 1e-9
     assert result.max_pressure_angle.value >= math.degrees(np.abs(result.pressure_angle).max()) - tol
     assert result.max_contact_force.value >= result.contact_force.max() - tol
@@ -110,8 +116,8 @@ def test_extremes_are_at_least_the_sampled_curves():
     assert result.min_curvature_radius.value <= convex.min() + tol
 
 
-def test_curves_are_read_only_and_the_profile_is_the_offset_pitch_curve():
-    result = camcad.analyse(camcad.load(OFFSET), toolpath=False)
+def test_curves_are_read_only_and_the_profile_is_the_offset_pitch_curve(offset):
+    result = offset
     n = result.phi.shape
     for name in ("angle_deg", "s", "v", "a", "j", "x", "y", "pitch_x", "pitch_y", "pressure_angle", "rho"):
         values = getattr(result, name)
@@ -169,10 +175,9 @@ def test_replace_gives_the_design_the_edited_file_gives(tmp_path):
     assert design.replace(**{"cam.bore": None}).spec.cam.bore == 0.0  # None: back to the default
 
 
-def test_result_build_writes_the_bytes_camcad_build_writes(tmp_path):
+def test_result_build_writes_the_bytes_camcad_build_writes(tmp_path, offset):
     api_out, cli_out = tmp_path / "api", tmp_path / "cli"
-    result = camcad.analyse(camcad.load(OFFSET), toolpath=False)
-    built = result.build(api_out, only=["tables", "dxf", "step"])
+    built = offset.build(api_out, only=["tables", "dxf", "step"])
     run = cli("build", str(OFFSET), "-o", str(cli_out), "--only", "tables,dxf,step", "-q")
     assert run.returncode == 0, run.stderr
     names = sorted(p.name for p in cli_out.iterdir())
@@ -203,9 +208,8 @@ def test_optimize_finds_the_smallest_base_radius_camcad_size_finds():
     assert math.isclose(found.best.values["base_radius"], sized, abs_tol=2e-3)
 
 
-def test_the_jupyter_renderings_are_well_formed():
-    design = camcad.load(OFFSET)
-    result = camcad.analyse(design, toolpath=False)
+def test_the_jupyter_renderings_are_well_formed(offset):
+    design, result = offset.design, offset
     card = etree.fromstring(result._repr_html_())
     text = "".join(card.itertext())
     assert f"{result.max_pressure_angle.value:.2f}°" in text and "all design limits hold" in text
@@ -216,8 +220,8 @@ def test_the_jupyter_renderings_are_well_formed():
         assert root.tag == "{http://www.w3.org/2000/svg}svg"
 
 
-def test_plot_draws_each_kind_and_refuses_others():
-    result = camcad.analyse(camcad.load(OFFSET), toolpath=False)
+def test_plot_draws_each_kind_and_refuses_others(offset):
+    result = offset
     for kind, panels in (("motion", 4), ("profile", 1), ("pressure", 1), ("dynamics", 3)):
         figure = result.plot(kind)
         assert len(figure.axes) == panels, kind
