@@ -12,11 +12,11 @@ notebooks::
     bigger = design.replace(**{"cam.base_radius": 45})    # a variant, validated by the loader
     camcad.analyse(bigger).build("out/", only=["dxf"])     # the same bytes as `camcad build`
 
-:class:`Design` keeps the TOML mapping it was read from: a variant is that
+``Design`` keeps the TOML mapping it was read from: a variant is that
 mapping with keys changed, read again by the loader
-(:func:`camcad.design.parse_design`), so every rule of the design file
+(``camcad.design.parse_design``), so every rule of the design file
 applies to it and a bad value is refused with the loader's message.
-:class:`Result` holds the figures of ``camcad check`` as :class:`Quantity`
+``Result`` holds the figures of ``camcad check`` as ``Quantity``
 attributes (value, unit, and the cam angle where an extreme occurs), the
 findings, and read-only arrays of every curve. In Jupyter both render
 themselves: the report's key-number cards (``_repr_html_``) and the cam
@@ -60,7 +60,7 @@ if TYPE_CHECKING:
 __all__ = ["PLOTS", "Design", "Quantity", "Result", "analyse", "load", "optimize", "sweep"]
 
 PLOTS = ("motion", "profile", "pressure", "dynamics")
-"""What :meth:`Result.plot` draws: s, v, a, j; the cam outline; the pressure angle; force, torque, stress."""
+"""What ``Result.plot`` draws: s, v, a, j; the cam outline; the pressure angle; force, torque, stress."""
 
 _PATH_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[(\d+)\])?$")
 
@@ -68,7 +68,7 @@ _PATH_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[(\d+)\])?$")
 class Design:
     """A validated design file, with the TOML mapping it was read from.
 
-    Make one with :func:`load`. It is immutable: :meth:`replace` gives a new
+    Make one with ``load``. It is immutable: ``replace`` gives a new
     design. ``spec`` is the validated, typed design (mm and radians) the
     pipeline runs on; ``data`` a copy of the TOML mapping (file units: mm,
     degrees, rpm).
@@ -90,7 +90,7 @@ class Design:
 
     @property
     def spec(self) -> DesignSpec:
-        """The validated design the pipeline runs on (:class:`camcad.design.Design`, mm and radians)."""
+        """The validated design the pipeline runs on (``camcad.design.Design``, mm and radians)."""
         return self._spec
 
     @property
@@ -143,11 +143,11 @@ class Design:
         return Design(data, source=self.source)
 
     def analyse(self, *, toolpath: bool = True, fea: bool | None = None) -> Result:
-        """Analyse this design; see :func:`analyse`."""
+        """Analyse this design; see ``analyse``."""
         return analyse(self, toolpath=toolpath, fea=fea)
 
     def build(self, outdir: str | os.PathLike[str], *, only: Iterable[str] | None = None) -> BuildResult:
-        """Write the design's files into ``outdir``, as ``camcad build`` does; see :meth:`Result.build`."""
+        """Write the design's files into ``outdir``, as ``camcad build`` does; see ``Result.build``."""
         from camcad.pipeline import build
 
         return build(self._spec, Path(outdir), only=only)
@@ -243,7 +243,7 @@ def load(source: str | os.PathLike[str]) -> Design:
     Parameters
     ----------
     source
-        A :class:`~pathlib.Path` or a string naming a file, or a string of
+        A ``pathlib.Path`` or a string naming a file, or a string of
         TOML text (any string with a line break is read as text). Point
         tables (``kind = "table"``) in text are read relative to the
         current folder.
@@ -327,31 +327,59 @@ def _readonly(values: Any) -> FloatArray:
 
 
 class Result:
-    """What :func:`analyse` computed: the figures of ``camcad check``, the findings and every curve.
+    """What ``analyse`` computed: the figures of ``camcad check``, the findings and every curve.
 
-    Figures (each a :class:`Quantity`, in the units ``camcad check`` prints)
-        ``lift`` (mm, or ° of swing for an arm), ``max_pressure_angle``
-        (°, with ``pressure_angle_limit``), ``min_curvature_radius`` (mm,
-        smallest convex), ``min_concave_radius`` (mm), ``max_torque``
-        (N·mm), ``max_contact_force``, ``min_contact_force`` (N),
-        ``max_contact_stress`` (MPa, Hertz), ``fit_max_error`` (mm),
-        ``max_von_mises`` (MPa, the finite-element check; None without it); and
-        ``undercut``, ``follower_jump`` (bool; None for a positive drive),
-        ``fit_control_points`` (int or None).
-    Curves (read-only float64 arrays over the same angles, shape (n,))
-        ``phi`` [rad] and ``angle_deg``; ``s, v, a, j`` (mm or degrees of
-        swing, per rad, rad², rad³); ``x, y`` (profile [mm], cam frame at
-        φ = 0) and ``pitch_x, pitch_y``; ``pressure_angle`` [rad];
-        ``rho`` (signed radius of curvature of the profile [mm]);
-        ``contact_force`` [N], ``torque`` [N·mm], ``contact_stress`` [MPa].
-    Everything else
-        ``findings`` (broken limits, hard first), ``violations`` (their
-        kinds), ``summary`` (the content of ``summary.json``) and
-        ``analysis`` (the pipeline's full :class:`camcad.analysis.Analysis`).
+    The figures are ``Quantity`` objects in the units ``camcad check``
+    prints, true extremes over the turn with the cam angle where they occur.
+    The curves are read-only float64 arrays of shape (n,) over the same
+    angles ``phi``.
+
+    Attributes
+    ----------
+    design : Design
+        The design analysed.
+    lift : Quantity
+        The largest lift [mm], or swing [°] for an arm (``lift_unit``).
+    max_pressure_angle, pressure_angle_limit : Quantity
+        The largest pressure angle |α| and the design's limit [°].
+    min_curvature_radius, min_concave_radius : Quantity
+        The smallest convex and concave radius of curvature of the profile [mm].
+    max_torque : Quantity
+        The largest input torque on the cam shaft [N·mm].
+    max_contact_force, min_contact_force : Quantity
+        The contact force's extremes [N].
+    max_contact_stress : Quantity
+        The largest Hertz contact stress [MPa].
+    max_von_mises : Quantity
+        The finite-element check's largest von Mises stress [MPa]; None without it.
+    fit_control_points : int or None
+        Control points of the certified NURBS fit.
+    fit_max_error : Quantity
+        The fit's certified largest error [mm].
+    undercut : bool
+        Whether the profile is undercut (a hard limit).
+    follower_jump : bool or None
+        Whether the follower leaves the cam; None for a positive drive.
+    phi, angle_deg : numpy.ndarray
+        Cam angle φ [rad] and [°].
+    s, v, a, j : numpy.ndarray
+        Lift and its derivatives in φ (mm, or ° of swing; per rad, rad², rad³).
+    x, y, pitch_x, pitch_y : numpy.ndarray
+        Profile and pitch curve [mm], cam frame at φ = 0.
+    pressure_angle : numpy.ndarray
+        Signed pressure angle [rad].
+    rho : numpy.ndarray
+        Signed radius of curvature of the profile [mm], positive where convex.
+    contact_force, torque, contact_stress : numpy.ndarray
+        Contact force [N], input torque [N·mm], Hertz stress [MPa].
+    summary : dict
+        The content of ``summary.json``.
+    analysis : camcad.analysis.Analysis
+        Everything the pipeline computed.
     """
 
     def __init__(self, design: Design, analysis: Analysis) -> None:
-        """Wrap an analysis of ``design``; use :func:`analyse` to make one."""
+        """Wrap an analysis of ``design``; use ``analyse`` to make one."""
         self.design = design
         self.analysis = analysis
         summary = analysis.summary()
@@ -392,7 +420,7 @@ class Result:
 
     @property
     def findings(self) -> tuple[Finding, ...]:
-        """Every broken limit of every stage, hard ones first (:class:`camcad.findings.Finding`)."""
+        """Every broken limit of every stage, hard ones first (``camcad.findings.Finding``)."""
         return self.analysis.findings
 
     @property
@@ -408,7 +436,7 @@ class Result:
     def build(self, outdir: str | os.PathLike[str], *, only: Iterable[str] | None = None) -> BuildResult:
         """Write the design's files into ``outdir`` exactly as ``camcad build`` does.
 
-        The build runs the pipeline's :func:`camcad.pipeline.build` on the
+        The build runs the pipeline's ``camcad.pipeline.build`` on the
         design (the same bytes as the command line), all or nothing: a
         failed build leaves ``outdir`` as it was.
 
@@ -432,7 +460,7 @@ class Result:
         return self.design.build(outdir, only=only)
 
     def plot(self, kind: str = "motion") -> Figure:
-        """A matplotlib figure of one of :data:`PLOTS`.
+        """A matplotlib figure of one of ``PLOTS``.
 
         Parameters
         ----------
@@ -451,7 +479,7 @@ class Result:
         Raises
         ------
         UsageError
-            ``kind`` is not one of :data:`PLOTS`.
+            ``kind`` is not one of ``PLOTS``.
         """
         from matplotlib.figure import Figure
 
@@ -553,7 +581,7 @@ def analyse(design: Design, *, toolpath: bool = True, fea: bool | None = None) -
     Parameters
     ----------
     design
-        From :func:`load` or :meth:`Design.replace`.
+        From ``load`` or ``Design.replace``.
     toolpath
         Plan the G-code toolpath too (it finds a gouge; it is most of the
         time of an analysis). The figures do not depend on it.
@@ -610,7 +638,7 @@ def optimize(
     camcad.explore.optimize.OptimizeResult
         ``best`` (one objective) or ``front`` (two), each a candidate with
         its values, objectives, constraints and ``data`` (the TOML mapping,
-        ready for :class:`Design`).
+        ready for ``Design``).
     """
     from camcad.explore.measures import measure, parse_limit
     from camcad.explore.optimize import Problem
