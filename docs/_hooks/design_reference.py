@@ -82,8 +82,24 @@ def _rows(props: dict[str, Any], required: list[str]) -> list[str]:
     return lines
 
 
+def _resolved(node: Any, schema: dict[str, Any]) -> Any:
+    """``node`` with every local ``$ref`` (``#/$defs/…``) replaced by what it points at."""
+    if isinstance(node, dict):
+        if isinstance(node.get("$ref"), str) and node["$ref"].startswith("#/"):
+            target: Any = schema
+            for part in node["$ref"][2:].split("/"):
+                target = target[part]
+            rest = {k: v for k, v in node.items() if k != "$ref"}
+            return _resolved({**target, **rest}, schema)
+        return {k: _resolved(v, schema) for k, v in node.items()}
+    if isinstance(node, list):
+        return [_resolved(v, schema) for v in node]
+    return node
+
+
 def reference_markdown(schema: dict[str, Any]) -> str:
     """The reference page's Markdown for a design-file JSON Schema."""
+    schema = _resolved(schema, schema)
     out = [INTRO]
     required = schema.get("required", [])
     for section, table in schema["properties"].items():

@@ -93,3 +93,40 @@ def test_a_broken_link_fails_the_build(tmp_path):
     )
     run = mkdocs_build(config, tmp_path / "site")
     assert run.returncode != 0 and "missing.md" in run.stderr
+
+
+def test_the_reference_shows_what_the_schema_gives(tmp_path):
+    """Defaults, descriptions, bounds, enums and local references of a schema all reach the page."""
+    import importlib.util
+
+    source = ROOT / "docs" / "_hooks" / "design_reference.py"
+    spec = importlib.util.spec_from_file_location("design_reference", source)
+    assert spec is not None and spec.loader is not None
+    hook = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hook)
+    schema = {
+        "$defs": {"length": {"type": "number", "minimum": 0.1, "maximum": 10000}},
+        "required": ["cam"],
+        "properties": {
+            "cam": {
+                "type": "object",
+                "required": ["base_radius"],
+                "properties": {
+                    "base_radius": {
+                        "$ref": "#/$defs/length",
+                        "default": 40,
+                        "description": "mm, the base circle",
+                    },
+                    "rotation": {"enum": ["ccw", "cw"]},
+                },
+            },
+            "motion": {
+                "type": "array",
+                "items": {"properties": {"kind": {"enum": ["rise"]}}, "required": ["kind"]},
+            },
+        },
+    }
+    page = hook.reference_markdown(schema)
+    assert "## `[cam]` (required)" in page and "## `[[motion]]`" in page
+    assert "| `base_radius` (required) | number | ≥ 0.1, ≤ 10000 | `40` | mm, the base circle |" in page
+    assert "| `rotation` | one of `ccw`, `cw` |  |  |  |" in page
