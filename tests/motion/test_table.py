@@ -128,7 +128,7 @@ def test_parse_header_comments_separators_and_closing_row():
     ("text", "words"),
     [
         ("0,1\n10,2\n5,3\n" + "".join(f"{20 + i},0\n" for i in range(12)), "angles must increase"),
-        ("0,1\n1,x\n", "not numbers"),
+        ("0,1\n1,x\n", "line 2, field 2: expected a number"),
         ("0,1\n1,2\n", "at least 12"),
         ("".join(f"{i * 30},{i}\n" for i in range(12)) + "360,5\n", "must repeat the row at 0°"),
         ("".join(f"{i * 30},{i},{i}\n" for i in range(11)) + "350,1\n", "different numbers of columns"),
