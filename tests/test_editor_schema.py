@@ -240,7 +240,9 @@ ISSUE_32 = [  # the changes the schema of issue 32 accepted and the loader refus
 ]
 
 
-@pytest.mark.parametrize(("sample", "path", "value"), ISSUE_32, ids=[_field(p) + f"={v}" for _, p, v in ISSUE_32])
+@pytest.mark.parametrize(
+    ("sample", "path", "value"), ISSUE_32, ids=[_field(p) + f"={v}" for _, p, v in ISSUE_32]
+)
 def test_issue_32_changes_are_refused_by_both(sample, path, value):
     data = _changed(sample, path, value)
     assert not VALIDATOR.is_valid(data)

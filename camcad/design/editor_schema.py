@@ -28,7 +28,7 @@ from camcad.design.schema import (  # the loader's rules, read only
 
 __all__ = ["design_json_schema", "rule_schema"]
 
-_KINDS = {
+_KINDS: dict[str, dict[str, Any]] = {
     "float": {"type": "number"},
     "int": {"type": "integer"},
     "bool": {"type": "boolean"},
@@ -82,7 +82,9 @@ def _motion_item() -> dict[str, Any]:
         )
     boundary = {
         "type": "object",
-        "properties": {k: _or_word(rule_schema(_BOUNDARY_RULE), "match", "a number, or match") for k in "vaj"},
+        "properties": {
+            k: _or_word(rule_schema(_BOUNDARY_RULE), "match", "a number, or match") for k in "vaj"
+        },
         "additionalProperties": False,
         "description": 'blend boundary values { v, a, j }: numbers or "match"',
     }

@@ -53,12 +53,12 @@ from camcad.geometry.spec import (
     Rotation,
     arm_problem,
 )
-from camcad.motion.blend import resolve_blends
 from camcad.motion._blendlaws import MAX_POLYNOMIAL_DEGREE
+from camcad.motion.blend import resolve_blends
 from camcad.motion.laws import DUDLEY_MAX_DEGREE, LAWS, make_law
 from camcad.motion.program import MotionProgram
 from camcad.motion.segments import Boundary, SegmentKind, SegmentSpec
-from camcad.motion.table import parse_table_text, smooth_table
+from camcad.motion.table import FLAG_SIGMAS, parse_table_text, smooth_table
 from camcad.toolpath.spec import Cutter, Machine, RotaryAxis
 
 if sys.version_info >= (3, 11):
@@ -177,7 +177,10 @@ def _interval(lo: float, hi: float, unit: str = "", *, lo_open: bool, hi_open: b
         below = v < hi if hi_open else v <= hi
         return None if above and below else f"must be in {text}{unit}{why}"
 
-    schema = {"exclusiveMinimum" if lo_open else "minimum": lo, "exclusiveMaximum" if hi_open else "maximum": hi}
+    schema = {
+        "exclusiveMinimum" if lo_open else "minimum": lo,
+        "exclusiveMaximum" if hi_open else "maximum": hi,
+    }
     return _Check(check, schema, f"{text}{unit}")
 
 
@@ -446,6 +449,7 @@ _MOTION_RULES: dict[str, _Rule] = {
 _BOUNDARY_RULE = _Rule("float", check=_between(-1e9, 1e9))  # start/end = { v, a, j }: a number or "match"
 _TABLE_ANGLE_RULE = _Rule("float", check=_Check(_full_turn, {"const": FULL_TURN_DEG}, "360"))
 
+
 def _law_rule(kind: str, law: str, name: str, check: _Check) -> _Rule:
     """A law parameter's rule, its refusal ending in the registry's own allowed text (``camcad laws``)."""
     (said,) = (p.allowed for p in LAWS[law].parameters if p.name == name)
@@ -646,7 +650,12 @@ def _segment(
         law_params.pop("velocity", None)
         for name, rule in _LAW_RULES.get(law_name, {}).items():
             if name in law_params:
-                _convert(f"{path}.{name}", rule, law_params[name])
+                try:
+                    _convert(f"{path}.{name}", rule, law_params[name])
+                except ValueRuleError as err:  # a wrong type: say what the law allows too
+                    if "allowed:" in err.message or rule.check is None:
+                        raise
+                    raise ValueRuleError(err.path, f"{err.message}; allowed: {rule.check.allowed}") from None
     try:
         law = make_law(law_name, **law_params)
     except DesignError as err:
@@ -731,12 +740,13 @@ def _table_segment(
     angle_rad, lift, velocity = parse_table_text(text, where=f"{path}.file")
     law = smooth_table(angle_rad, lift, noise=noise, velocity=velocity, source=Path(name).name)
     lowest, at = law.trough
-    if lowest < -noise:  # as a return below the base circle is refused (_check_program)
+    if lowest < -FLAG_SIGMAS * noise:  # as a return below the base circle is refused (_check_program)
+        at_deg = math.degrees(at) if math.degrees(at) < FULL_TURN_DEG - 5e-4 else 0.0
         raise DesignError(
             f"{path}.file",
-            f"the smoothed lift dips to {lowest:.6g} at φ = {math.degrees(at):.3f}°, below the base circle "
-            f"(lift 0) by more than the stated noise {noise:g} mm; allowed: lift ≥ 0 over the whole turn "
-            "(measure from the base circle)",
+            f"the smoothed lift dips to {lowest:.6g} at φ = {at_deg:.3f}°, below the base circle (lift 0) by "
+            f"more than the stated noise explains ({FLAG_SIGMAS:g} σ = {FLAG_SIGMAS * noise:g}); allowed: "
+            "lift ≥ 0 over the whole turn (measure from the base circle)",
         )
     return SegmentSpec(kind=SegmentKind.TABLE, span=FULL_TURN_DEG * DEG, law=law)
 
@@ -1013,8 +1023,8 @@ def _check_fea(design: Design) -> None:
             "fea.mesh_size",
             f"{size:g} mm would fill the plate (at least the {area:.0f} mm² of the base circle outside the "
             f"bore) with {estimated_triangles(area, size):.3g} triangles or more; allowed: at most "
-            f"{MAX_ELEMENTS} (mesh_size ≥ {smallest_mesh_size(area):.3g} mm for this base circle, more for the "
-            "whole plate)",
+            f"{MAX_ELEMENTS} (mesh_size ≥ {smallest_mesh_size(area):.3g} mm for this base circle, more "
+            "for the whole plate)",
         )
 
 
@@ -1159,7 +1169,8 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
     folder = Path(source).parent if source else None
     omega = specs["cam"].omega
     motion = tuple(
-        _segment(i, seg, omega=omega, folder=folder, confine_to=confine_to) for i, seg in enumerate(raw_motion)
+        _segment(i, seg, omega=omega, folder=folder, confine_to=confine_to)
+        for i, seg in enumerate(raw_motion)
     )
     motion = _finish_motion(motion, unit="°" if follower.kind.oscillating else " mm")
     design = Design(motion=motion, source=source, **specs)

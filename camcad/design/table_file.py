@@ -37,9 +37,7 @@ def _shown(path: Path | str) -> str:
     return text if len(text) <= 200 else text[:100] + "…" + text[-99:]
 
 
-def read_table_file(
-    name: str, *, folder: Path | None, where: str, confine_to: Path | None = None
-) -> str:
+def read_table_file(name: str, *, folder: Path | None, where: str, confine_to: Path | None = None) -> str:
     """The text of a point table's file, read by the rules of the module notes.
 
     Parameters
@@ -73,9 +71,12 @@ def read_table_file(
         real = Path(os.path.realpath(file))
         if not real.is_relative_to(root):
             raise DesignError(
-                where, f"{_shown(name)} leads outside the design's folder; allowed: a file inside {_shown(root)}"
+                where,
+                f"{_shown(name)} leads outside the design's folder; allowed: a file inside {_shown(root)}",
             )
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOCTTY", 0)
+    flags = (
+        os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOCTTY", 0)
+    )
     try:
         fd = os.open(file, flags)
     except OSError as err:
@@ -83,7 +84,9 @@ def read_table_file(
     try:
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
-            what = "a folder" if stat.S_ISDIR(info.st_mode) else "not a regular file (a device, pipe or socket)"
+            what = (
+                "a folder" if stat.S_ISDIR(info.st_mode) else "not a regular file (a device, pipe or socket)"
+            )
             raise DesignError(where, f"cannot read {_shown(file)}: it is {what}; allowed: a regular file")
         if info.st_size > MAX_TABLE_BYTES:
             raise DesignError(
@@ -104,7 +107,9 @@ def read_table_file(
     finally:
         os.close(fd)
     if size > MAX_TABLE_BYTES:  # the file grew after fstat
-        raise DesignError(where, f"cannot read {_shown(file)}: allowed: at most {MAX_TABLE_BYTES} bytes (16 MiB)")
+        raise DesignError(
+            where, f"cannot read {_shown(file)}: allowed: at most {MAX_TABLE_BYTES} bytes (16 MiB)"
+        )
     data = b"".join(chunks)
     try:
         return data.decode("utf-8-sig")

@@ -15,6 +15,7 @@ from camcad.extremes import SIDE_WORDS, Extreme, Kind, Quantity, Side, extremes_
 from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
+from camcad.geometry.envelope import LineElement, PointElement
 from camcad.geometry.followers.tied import TiedRoller
 from camcad.geometry.sizing import min_base_radius
 from camcad.roots import brent_root
@@ -405,7 +406,7 @@ def conjugate_overlap(partner: Cam) -> tuple[str, str] | None:
         return None
     first = tied.first
     motion = partner.motion(0.0)
-    m1 = first.element(motion).m0[0]
+    m1 = _centre(first.element(motion))
     gap = float(np.hypot(*(tied.element(motion).m0[0] - m1)))
     need = first.roller_radius + tied.roller_radius
     if gap >= need:
@@ -418,7 +419,7 @@ def conjugate_overlap(partner: Cam) -> tuple[str, str] | None:
     else:
         breakpoints = partner.program.breakpoints
         top_phi = max((bp.phi for bp in breakpoints), key=lambda p: float(partner.motion(p).s[0]))
-        a = float(np.hypot(*first.element(partner.motion(top_phi)).m0[0]))
+        a = float(np.hypot(*_centre(first.element(partner.motion(top_phi)))))
         b = partner.base_radius + tied.roller_radius
         cos_max = (a * a + b * b - need * need) / (2.0 * a * b)  # |Δ|² ≥ need² by the law of cosines
         how = f"centres {a:.4g} mm and {b:g} mm from the cam axis at the top of the lift"
@@ -430,8 +431,16 @@ def conjugate_overlap(partner: Cam) -> tuple[str, str] | None:
     return (
         "conjugate.angle",
         f"{math.degrees(conj.angle):g}° puts the two rollers' centres {gap:.4g} mm apart at every cam "
-        f"angle, less than the sum of their radii {need:g} mm: the rollers overlap ({how}); allowed: {allowed}",
+        f"angle, less than the sum of their radii {need:g} mm: the rollers overlap ({how}); "
+        f"allowed: {allowed}",
     )
+
+
+def _centre(element: PointElement | LineElement) -> FloatArray:
+    """A roller's centre [mm] (a conjugate pair drives rollers: the element is a point path)."""
+    assert isinstance(element, PointElement), "a conjugate pair needs roller followers"
+    out: FloatArray = element.m0[0]
+    return out
 
 
 def _up(value: float) -> float:

@@ -176,7 +176,7 @@ class TableLaw(Law):
 
     @property
     def trough(self) -> tuple[float, float]:
-        """(smallest displacement [mm], its angle [rad]): the spline at the roots of its velocity and the knots.
+        """(smallest displacement [mm], its angle [rad]): the spline at its velocity's roots and its knots.
 
         Exact to the root finder: s is a quintic on each knot span, so its
         minimum lies at a root of the quartic v = ds/dφ or at a span's end.
@@ -251,18 +251,20 @@ def parse_table_text(text: str, *, where: str = "file") -> tuple[FloatArray, Flo
             continue
         cells = [c for c in line.replace(";", ",").replace("\t", ",").replace(" ", ",").split(",") if c]
         values: list[float] = []
-        for column, cell in enumerate(cells, start=1):
+        column = 0  # the first cell that is not a number (1-based), 0 if none
+        for k, cell in enumerate(cells, start=1):
             try:
                 values.append(float(cell))
             except ValueError:
+                column = k
                 break
-        else:
-            column = 0
         if column:
             if first_data and not rows:
                 first_data = False
                 continue  # the header
-            raise DesignError(where, f"line {number}, field {column}: expected a number (the text is not one)")
+            raise DesignError(
+                where, f"line {number}, field {column}: expected a number (the text is not one)"
+            )
         first_data = False
         if len(values) < 2:
             raise DesignError(where, f"line {number}: needs angle and lift, got {len(values)} value")
