@@ -58,7 +58,13 @@ from camcad.motion.blend import resolve_blends
 from camcad.motion.laws import DUDLEY_MAX_DEGREE, LAWS, make_law
 from camcad.motion.program import MotionProgram
 from camcad.motion.segments import Boundary, SegmentKind, SegmentSpec
-from camcad.motion.table import FLAG_SIGMAS, parse_table_text, smooth_table
+from camcad.motion.table import (
+    FLAG_SIGMAS,
+    SCATTER_MIN_POINTS,
+    parse_table_text,
+    smooth_table,
+    table_scatter,
+)
 from camcad.toolpath.spec import Cutter, Machine, RotaryAxis
 
 if sys.version_info >= (3, 11):
@@ -71,6 +77,8 @@ __all__ = ["load_design", "parse_design"]
 FULL_TURN_DEG = 360.0
 ANGLE_SUM_TOL_DEG = 1e-9
 LIFT_CLOSE_TOL_MM = 1e-9
+SCATTER_PER_NOISE = 1.5  # a long table scattering more than this × its stated noise is refused (at 2.2× a
+# 36 000-row table ran past 120 s; at 1.46×, 7 s)
 
 # ---------------------------------------------------------------------------
 # schema: one rule per key; the rule converts and checks the TOML value
@@ -738,6 +746,15 @@ def _table_segment(
     noise = _convert(f"{path}.noise", _MOTION_RULES["noise"], table["noise"])
     text = read_table_file(name, folder=folder, where=f"{path}.file", confine_to=confine_to)
     angle_rad, lift, velocity = parse_table_text(text, where=f"{path}.file")
+    if angle_rad.size >= SCATTER_MIN_POINTS:  # FITPACK would chase the scatter with knots for minutes
+        scatter = table_scatter(angle_rad, lift)
+        if scatter > SCATTER_PER_NOISE * noise:
+            raise DesignError(
+                f"{path}.noise",
+                f"{noise:g} is far below the table's own scatter (about {scatter:.3g}, from its sixth "
+                f"differences): the smoothing could not come within the stated noise; allowed: noise ≥ "
+                f"{scatter / SCATTER_PER_NOISE:.3g} for this table (its measurement's σ or rounding)",
+            )
     law = smooth_table(angle_rad, lift, noise=noise, velocity=velocity, source=Path(name).name)
     lowest, at = law.trough
     if lowest < -FLAG_SIGMAS * noise:  # as a return below the base circle is refused (_check_program)

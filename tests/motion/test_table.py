@@ -353,3 +353,25 @@ def test_a_table_below_the_base_circle_is_refused(tmp_path):
     assert "dips to -0.5" in err.message and "φ = 0.000°" in err.message
     (tmp_path / "noisy.csv").write_text(_good_rows(lambda a: 5 * (1 - math.cos(math.radians(a))) - 2 * SIGMA))
     parse_design(_table_design("noisy.csv"), source=str(tmp_path / "cam.toml"))  # within the noise: kept
+
+
+def test_a_long_table_with_a_noise_below_its_scatter_is_refused_at_once(tmp_path):
+    """A 36 000-row table rounded to 0.1 µm with noise 1e-6 ran for more than 10 minutes (issue 32).
+
+    Independent: rounding to q scatters within ±q/2 (σ = q/√12 if uniform and independent; on a
+    slowly varying law the rounding errors are correlated, so the estimate lies between that and q/2).
+    """
+    from camcad.motion.table import table_scatter
+
+    phi = np.arange(36000) * 0.01
+    lift = np.round(5 * (1 - np.cos(np.radians(phi))), 4)
+    assert 1e-4 / math.sqrt(12) <= table_scatter(np.radians(phi), lift) <= 1e-4 / 2
+    rows = "".join(f"{a:.2f},{s:.4f}\n" for a, s in zip(phi, lift, strict=True))
+    (tmp_path / "lift.csv").write_text("angle,lift\n" + rows)
+    data = _table_design("lift.csv")
+    data["motion"][0]["noise"] = 1e-6
+    err = _refusal(data, tmp_path / "cam.toml")
+    assert err.path == "motion[0].noise" and "far below the table's own scatter" in err.message
+    noisy, _ = noisy_table(5, step_deg=0.25)  # 1440 rows of noise σ: the estimate finds σ
+    _, lift_noisy = noisy_table(5, step_deg=0.25)
+    assert table_scatter(noisy, lift_noisy) == pytest.approx(SIGMA, rel=0.15)
