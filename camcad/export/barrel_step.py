@@ -184,7 +184,7 @@ def barrel_shape(fit: BarrelWallFit, options: BarrelOptions) -> BarrelSolid:
     if not BRepCheck_Analyzer(shape).IsValid():
         raise ExportError("OpenCASCADE's BRepCheck_Analyzer finds the barrel's solid invalid")
     props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape, props)
+    BRepGProp.VolumeProperties_s(shape, props, 1e-7)  # adaptive: the default rule is off by 1e-4 here
     return BarrelSolid(shape=shape, volume=float(props.Mass()))
 
 
@@ -196,7 +196,6 @@ def barrel_step_bytes(solid: BarrelSolid, *, name: str = "barrel cam") -> bytes:
 
     Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
     Interface_Static.SetCVal_s("write.step.unit", "MM")
-    Interface_Static.SetCVal_s("write.step.product.name", name)
     from OCP.Message import Message, Message_PrinterOStream
 
     Message.DefaultMessenger_s().RemovePrinters(Message_PrinterOStream.get_type_descriptor_s())
@@ -214,5 +213,6 @@ def barrel_step_bytes(solid: BarrelSolid, *, name: str = "barrel cam") -> bytes:
         count=1,
         flags=re.DOTALL,
     )
-    text = re.sub(r"Open CASCADE STEP translator [^']*", name.replace("'", ""), text)
+    safe = name.replace("'", "")  # OpenCASCADE numbers its products per session: name it ourselves
+    text = re.sub(r"PRODUCT\('[^']*',\s*'[^']*'", f"PRODUCT('{safe}','{safe}'", text)
     return text.encode("ascii")
