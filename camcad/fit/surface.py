@@ -264,7 +264,7 @@ def _fit_once(
     )
 
 
-def certify_surface(
+def _certify(
     surface: BSplineSurface,
     program: MotionProgram,
     follower: BarrelFollower,
@@ -273,11 +273,10 @@ def certify_surface(
     *,
     step: float = math.radians(0.1),
     stations: int = 41,
-) -> SurfaceCertificate:
-    """Bound max |S − W| over the whole parameter rectangle (module notes).
+) -> tuple[SurfaceCertificate, FloatArray, FloatArray]:
+    """The certificate, the |S − W| grid (n_φ, n_t) and its angles φ (n_φ,) [rad].
 
-    ``step`` [rad]: the check grid in φ (every joint added); ``stations``: the
-    check grid's stations, uniform over the fitted range.
+    See :func:`certify_surface`.
     """
     phi = program.sample_phi(step)
     t = np.linspace(*surface.station_range, stations)
@@ -294,7 +293,26 @@ def certify_surface(
     # across a joint two cells meet; the second difference there straddles it, which is what we want
     d2_t = np.linalg.norm(err[:, 2:] - 2.0 * err[:, 1:-1] + err[:, :-2], axis=-1)
     bound = node + CERT_SAFETY * (float(np.max(d2_phi)) + float(np.max(d2_t))) / 8.0
-    return SurfaceCertificate(node_max=node, bound=bound, grid=(len(phi), stations))
+    cert = SurfaceCertificate(node_max=node, bound=bound, grid=(len(phi), stations))
+    return cert, np.linalg.norm(err, axis=-1), phi
+
+
+def certify_surface(
+    surface: BSplineSurface,
+    program: MotionProgram,
+    follower: BarrelFollower,
+    options: BarrelOptions,
+    side: WallSide,
+    *,
+    step: float = math.radians(0.1),
+    stations: int = 41,
+) -> SurfaceCertificate:
+    """Bound max |S − W| over the whole parameter rectangle (module notes).
+
+    ``step`` [rad]: the check grid in φ (every joint added); ``stations``: the
+    check grid's stations, uniform over the fitted range.
+    """
+    return _certify(surface, program, follower, options, side, step=step, stations=stations)[0]
 
 
 def _fit_wall(
@@ -319,17 +337,12 @@ def _fit_wall(
         data = _exact(program, follower, options, phi, t, side)
         v = (t - span[0]) / (span[1] - span[0])
         surface = _fit_once(phi / TWO_PI, v, data, tau, interior_v, span)
-        cert = certify_surface(surface, program, follower, options, side)
+        cert, err, phi_c = _certify(surface, program, follower, options, side)
         if best is None or cert.max_error < best[1].max_error:
             best = (surface, cert)
         if cert.max_error <= fit.tolerance:
             return surface, cert
         # where the error lives: at the check grid's stations (worst over φ) and angles (worst over t)
-        phi_c = program.sample_phi(math.radians(0.1))
-        t_c = np.linspace(*span, 41)
-        err = np.linalg.norm(
-            surface.at(phi_c, t_c) - _exact(program, follower, options, phi_c, t_c, side), axis=-1
-        )
         along_t = err.max(axis=0)
         along_u = err.max(axis=1)
         if float(np.max(along_t)) > 0.5 * fit.tolerance and float(np.ptp(along_t)) > 0.5 * float(

@@ -50,7 +50,7 @@ from scipy.spatial import cKDTree
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import DesignError
-from camcad.geometry.barrel import BarrelFollower, BarrelOptions
+from camcad.geometry.barrel import BarrelFollower, BarrelOptions, RollerShape
 from camcad.geometry.barrel_limits import developed_walls
 from camcad.motion.program import MotionProgram
 
@@ -190,7 +190,9 @@ def plan_barrel(
     DesignError
         ``gcode.rough_diameter`` not smaller than the groove is wide less
         twice the stock; ``gcode.step_down``, ``gcode.stepover``,
-        ``gcode.stock``, ``gcode.tolerance`` not positive.
+        ``gcode.stock``, ``gcode.tolerance`` not positive; ``follower.roller``
+        conical (a cylindrical cutter cuts a conical roller's walls exactly at
+        one station only).
     """
     for path, value in (
         ("gcode.tolerance", spec.tolerance),
@@ -200,6 +202,12 @@ def plan_barrel(
     ):
         if not (math.isfinite(value) and value > 0.0):
             raise DesignError(path, f"{value!r} is not allowed; give a number > 0")
+    if options.roller is RollerShape.CONICAL:
+        raise DesignError(
+            "follower.roller",
+            '"conical": its walls need a tapered cutter, which camcad does not plan yet; '
+            'the 4-axis program is for "cylindrical" rollers',
+        )
     if not (math.isfinite(spec.stock) and spec.stock >= 0.0):
         raise DesignError("gcode.stock", f"{spec.stock!r} mm is not allowed; give 0 mm or more")
     r_w = options.roller_radius + 0.5 * options.clearance

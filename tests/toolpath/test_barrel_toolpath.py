@@ -71,7 +71,17 @@ def test_a_smaller_cutter_leaves_stock_at_bottom_and_top_as_estimated():
     ],
 )
 def test_bad_options_name_their_field(field, change):
+    """Each bad option is refused naming its field."""
     spec = replace(BarrelToolpathOptions(), **change)
     with pytest.raises(DesignError) as err:
         plan_barrel(INDEXER.program, INDEXER.follower, INDEXER.options, spec)
     assert err.value.path == field
+
+
+def test_a_conical_roller_is_refused_naming_the_field():
+    from camcad.geometry.barrel import RollerShape
+
+    options = replace(INDEXER.options, roller=RollerShape.CONICAL)
+    with pytest.raises(DesignError) as err:
+        plan_barrel(INDEXER.program, INDEXER.follower, options, BarrelToolpathOptions())
+    assert err.value.path == "follower.roller"
