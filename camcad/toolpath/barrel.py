@@ -114,11 +114,17 @@ class BarrelPass:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class BarrelToolpath:
-    """Every pass in cutting order, with the options and the barrel they were planned for."""
+    """Every pass in cutting order, with the options and the barrel they were planned for.
+
+    ``small_cutter`` (2, 2, 2) [mm]: what finishing the walls with the roughing
+    cutter instead would leave (:func:`small_cutter_deviation`) at the
+    groove's bottom and top (rows), upper and lower wall, (least, greatest).
+    """
 
     passes: tuple[BarrelPass, ...]
     options: BarrelToolpathOptions
     barrel: BarrelOptions
+    small_cutter: FloatArray
 
     @property
     def max_deviation(self) -> float:
@@ -254,7 +260,10 @@ def plan_barrel(
         )
         for name, sign in (("upper", 1.0), ("lower", -1.0))
     ]
-    return BarrelToolpath(passes=tuple(passes), options=spec, barrel=options)
+    small = small_cutter_deviation(
+        program, follower, options, r_c, np.array([options.bottom_radius, options.barrel_radius])
+    )
+    return BarrelToolpath(passes=tuple(passes), options=spec, barrel=options, small_cutter=small)
 
 
 def small_cutter_deviation(

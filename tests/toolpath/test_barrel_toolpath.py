@@ -44,6 +44,19 @@ def test_blocks_keep_the_axis_within_tolerance(name):
         assert abs(p.shift) + p.radius <= c.options.roller_radius + 0.5 * c.options.clearance + 1e-12
 
 
+def test_the_program_reports_the_small_cutters_deviation():
+    from camcad.export.gcode.barrel import render_barrel_program
+
+    c = INDEXER
+    tp = plan_barrel(c.program, c.follower, c.options, BarrelToolpathOptions())
+    again = small_cutter_deviation(
+        c.program, c.follower, c.options, 5.0, np.array([c.options.bottom_radius, c.options.barrel_radius])
+    )
+    assert np.array_equal(tp.small_cutter, again)
+    text = render_barrel_program(tp)
+    assert f"{np.abs(again[0]).max():.4f} at the groove's bottom" in text
+
+
 def test_a_smaller_cutter_leaves_stock_at_bottom_and_top_as_estimated():
     c = INDEXER
     o = c.options

@@ -44,6 +44,9 @@ def render_barrel_program(toolpath: BarrelToolpath, *, name: str = "barrel cam")
         f"finish: T{s.finish_tool} flat end mill D{2 * o.roller_radius:.3f} (the roller's diameter) "
         "along the roller's own path, one pass per wall",
         f"tolerance: {s.tolerance:.4f}, measured path deviation {toolpath.max_deviation:.4f}",
+        f"a wall finished with T{s.rough_tool} instead (exact at the pitch station) would be off by up to "
+        f"{float(abs(toolpath.small_cutter[0]).max()):.4f} at the groove's bottom and "
+        f"{float(abs(toolpath.small_cutter[1]).max()):.4f} at its top",
     ]
     out = [f"({comment_text(t)})" for t in head]
     out += ["G21 G90 G17 G40 G49 G94 G64 P" + _n(s.tolerance)]
