@@ -104,7 +104,7 @@ def oscillating_convention() -> None:
             textcoords="offset points",
             xytext=(4, -14),
         )
-        if cam.is_roller:
+        if cam.has_pitch_curve:
             centre = follower.element(cam.motion(np.array([0.0]))).m0[0]
             ax.annotate(
                 f"l = {cam.follower.arm_length:g}",
