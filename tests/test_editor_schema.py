@@ -264,3 +264,60 @@ def test_the_motion_laws_parameters_are_checked_per_law():
     degrees = range(1, 12)
     schema = [d for d in degrees if VALIDATOR.is_valid(_changed("hren_tappet", ("motion", 0, "degree"), d))]
     assert schema == [3, 5, 7, 9, 11]  # hren_tappet's rise is a Dudley polynomial: odd degrees from 3
+
+
+_FOLLOWER_VALUES = {  # a value of every [follower] key that builds with the base below, whatever the kind
+    "roller_radius": 10.0,
+    "offset": 1.0,
+    "face_width": 200.0,
+    "face_margin": 1.0,
+    "pivot_distance": 120.0,
+    "arm_length": 90.0,
+    "face_offset": 0.0,
+    "face_radius": 40.0,
+}
+
+
+def _follower_design(follower: dict[str, Any]) -> dict[str, Any]:
+    return {
+        "cam": {"base_radius": 40.0},
+        "follower": follower,
+        "motion": [
+            {"kind": "rise", "angle": 120.0, "lift": 15.0, "law": "cycloidal"},
+            {"kind": "dwell", "angle": 60.0},
+            {"kind": "return", "angle": 120.0, "lift": 15.0, "law": "cycloidal"},
+            {"kind": "dwell", "angle": 60.0},
+        ],
+    }
+
+
+def test_each_follower_types_keys_in_the_schema_are_the_loaders():
+    """Issue 33: per type of the registry, its required keys and no other type's; schema and loader agree.
+
+    For every type: its required keys alone load; each missing, and each other key added, is refused
+    by the loader naming that key exactly when the schema refuses it.
+    """
+    from camcad.geometry.followers import DEFAULT_FOLLOWER, FOLLOWER_TYPES, follower_keys
+
+    assert set(_FOLLOWER_VALUES) == set(follower_keys()), "give the new key a value here"
+    for kind in FOLLOWER_TYPES.values():
+        own = {k.name for k in kind.keys}
+        base = {"type": kind.word} | {k: _FOLLOWER_VALUES[k] for k in kind.required}
+        variants = [("", base)]
+        variants += [(k, {n: v for n, v in base.items() if n != k}) for k in kind.required]
+        variants += [(k, base | {k: _FOLLOWER_VALUES[k]}) for k in follower_keys() if k not in kind.required]
+        if kind is DEFAULT_FOLLOWER:
+            variants += [(k, {n: v for n, v in f.items() if n != "type"}) for k, f in variants]
+        for key, follower in variants:
+            data = _follower_design(follower)
+            schema_ok = not list(VALIDATOR.iter_errors(data))
+            try:
+                parse_design(data)
+                loader_ok = True
+            except DesignError as err:
+                assert err.path == f"follower.{key}", (kind.word, follower, err)
+                loader_ok = False
+            assert schema_ok == loader_ok == (key == "" or (key in own and key not in kind.required)), (
+                kind.word,
+                follower,
+            )

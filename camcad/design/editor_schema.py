@@ -8,6 +8,9 @@ generated from the same rule table :func:`camcad.design.parse_design` checks
 the type and the words come from the rule, the bounds (open or closed, "0 or
 a range", odd integers, list lengths) from the JSON Schema keywords each
 check declares beside its test, so the two cannot drift apart.
+The ``[follower]`` keys, their descriptions and which keys each ``type``
+requires or refuses come from the follower modules' declarations (the
+registry, :data:`camcad.geometry.followers.FOLLOWER_TYPES`), as the loader's do.
 Cross-field checks (a face width that covers the contact's travel, a lift
 that closes) remain the loader's: the schema catches what one key alone can.
 """
@@ -25,6 +28,7 @@ from camcad.design.schema import (  # the loader's rules, read only
     _TABLE_ANGLE_RULE,
     _Rule,
 )
+from camcad.geometry.followers import DEFAULT_FOLLOWER, FOLLOWER_TYPES, follower_keys
 
 __all__ = ["design_json_schema", "rule_schema"]
 
@@ -104,6 +108,29 @@ def _motion_item() -> dict[str, Any]:
     }
 
 
+def _follower_kinds(props: dict[str, Any]) -> list[dict[str, Any]]:
+    """Each follower type's own keys, as its module declares them: required ones, and no other kind's.
+
+    One ``if type = … then`` per type of the registry (the default type also
+    when ``type`` is absent); each key's description starts with its module's.
+    """
+    keys = follower_keys()
+    for name, key in keys.items():
+        said = props[name].get("description")
+        props[name]["description"] = f"{key.description}; {said}" if said else key.description
+    out = []
+    for kind in FOLLOWER_TYPES.values():
+        own = {k.name for k in kind.keys}
+        chosen: dict[str, Any] = {"properties": {"type": {"const": kind.word}}, "required": ["type"]}
+        if kind is DEFAULT_FOLLOWER:
+            chosen = {"anyOf": [chosen, {"not": {"required": ["type"]}}]}
+        then: dict[str, Any] = {"properties": {name: False for name in keys if name not in own}}
+        if kind.required:
+            then["required"] = list(kind.required)
+        out.append({"if": chosen, "then": then})
+    return out
+
+
 def design_json_schema() -> dict[str, Any]:
     """The JSON Schema (draft 2020-12) of a camcad design file."""
     properties: dict[str, Any] = {}
@@ -113,6 +140,8 @@ def design_json_schema() -> dict[str, Any]:
         table: dict[str, Any] = {"type": "object", "properties": props, "additionalProperties": False}
         if required:
             table["required"] = required
+        if section == "follower":
+            table["allOf"] = _follower_kinds(props)
         properties[section] = table
     properties["motion"] = {"type": "array", "minItems": 1, "items": _motion_item()}
     return {
