@@ -227,7 +227,8 @@ def _vibration_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
         rows.append(
             (
                 "polydyne lift correction",
-                f"max |c − s| {vib[f'lift_correction_max_{unit}']:.4g}{shown} (tuned for {vib['compensate_rpm']:g} rpm)",
+                f"max |c − s| {vib[f'lift_correction_max_{unit}']:.4g}{shown}"
+                f" (tuned for {vib['compensate_rpm']:g} rpm)",
             )
         )
     return rows

@@ -640,7 +640,7 @@ def _write_steps(analysis: Analysis, folder: Path) -> list[Path]:
 
 
 def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
-    """motion.csv, profile.csv, dynamics.csv, points.csv and lift.csv into ``folder`` (and the optional ones)."""
+    """motion.csv, profile.csv, dynamics.csv, points.csv, lift.csv and the optional tables into ``folder``."""
     from camcad.export.tables import write_lift_csv, write_points_csv
 
     cam, geo, design = analysis.cam, analysis.geometry, analysis.design

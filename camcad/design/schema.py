@@ -801,7 +801,7 @@ def _check_service(design: Design) -> None:
 
 
 def _check_vibration(design: Design) -> None:
-    """[vibration] (issue 34) against the follower, the drive, the speed and the laws; exit 2 naming the field."""
+    """``[vibration]`` (issue 34) against the follower, the drive, the speed and the laws (exit 2)."""
     vib = design.vibration
     if vib is None:
         return

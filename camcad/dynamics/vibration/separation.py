@@ -75,7 +75,7 @@ class HybridMotion:
 
 
 def _hermite_lift(grid: Grid, phi: float, omega: float, unit: float) -> tuple[float, float]:
-    """s and ṡ [generalised units, per s] at cam angle ``phi`` [rad] from the grid's Hermite polynomials."""
+    """Lift s and ṡ [generalised units, per s] at ``phi`` [rad] from the grid's Hermite polynomials."""
     p = phi % TWO_PI
     i = min(max(int(np.searchsorted(grid.phi, p, side="right")) - 1, 0), grid.piece.size - 1)
     h = float(grid.step[grid.piece[i]])
