@@ -153,6 +153,9 @@ def analyse(
     vibration = None
     if design.vibration is not None:  # issue 34: the elastic train; a polydyne cam is cut from its lift c
         vibration = _timed(timings, progress, "vibration", lambda: _vibration(design, cam))
+        stop = [f for f in vibration.findings if f.hard]  # the follower leaves a spring-loaded cam
+        if stop and strict:
+            raise DesignLimitError(f"{stop[0].field}: {stop[0].message}")
         if vibration.compensated is not None:
             from camcad.dynamics.vibration import compensated_program
 

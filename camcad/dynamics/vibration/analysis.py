@@ -198,7 +198,8 @@ def analyse_vibration(
                 message=(
                     f"the elastic follower train leaves the cam at {math.degrees(first):.2f}° "
                     f"at {speed_rpm:g} rpm "
-                    f"(contact force would reach {response.contact_force_min.value:.4g}): raise the spring "
+                    f"(contact force would reach {response.contact_force_min.value:.4g} "
+                    f"{'N·mm' if arm_angle is not None else 'N'}): raise the spring "
                     "preload or rate, stiffen the train, or lower the speed"
                 ),
                 angle=first,
