@@ -343,7 +343,10 @@ class CompensatedProgram(MotionProgram):
     fit, toolpath, every export) is then made from c, not from the program.
     """
 
-    compensated: CompensatedMotion | None = None
+    # equality and hash by what decides c (program, train, speed), not by the solver's arrays
+    compensated: CompensatedMotion | None = field(default=None, compare=False, hash=False)
+    train: Train | None = None
+    speed_rpm: float = 0.0
     _peak: dict[str, float] = field(default_factory=dict, init=False, compare=False, hash=False, repr=False)
 
     def _evaluate_segment(
@@ -397,4 +400,6 @@ def _largest(cam: CompensatedMotion) -> float:
 def compensated_program(cam: CompensatedMotion) -> CompensatedProgram:
     """The polydyne cam's contact lift as a motion program (see :class:`CompensatedProgram`)."""
     p = cam.program
-    return CompensatedProgram(p.segments, p.starts, p.base_s, compensated=cam)
+    return CompensatedProgram(
+        p.segments, p.starts, p.base_s, compensated=cam, train=cam.train, speed_rpm=cam.speed_rpm
+    )
