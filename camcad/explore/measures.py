@@ -16,9 +16,14 @@ name                      unit  figure
 ``roller_life_h``         h     track roller's L10 life (``[life]``; issue 35)
 ``min_film_ratio``        1     smallest film ratio λ (``[lubrication]``)
 ``motor_rms_torque``      N·m   motor's RMS torque (``[drive]``)
+``vibration_residual_mm`` mm    largest residual vibration in a dwell at the
+                                design speed (``[vibration]``; issue 34;
+                                degrees of swing on an arm)
+``min_dynamic_contact_``  N     smallest contact force of the elastic train at
+``force``                       the design speed (``[vibration]``; N·mm on an arm)
 ========================  ====  =================================================
 
-The last three are empty (None) for a design without their table.
+The last five are empty (None) for a design without their table.
 
 A limit is ``name<=value`` or ``name>=value`` in those units (``--limit
 contact_stress<=800``).
@@ -70,6 +75,15 @@ def _torque(summary: Mapping[str, Any]) -> float | None:
     return max(values) if values else None
 
 
+def _residual(summary: Mapping[str, Any]) -> float | None:
+    """The largest residual vibration over the dwells at the design speed [mm, or deg on an arm]."""
+    vib = summary.get("vibration")
+    if vib is None:
+        return None
+    values = vib.get("residual_mm", vib.get("residual_deg", []))
+    return max(values) if values else None
+
+
 _FIGURES: dict[str, Callable[[Analysis, Mapping[str, Any]], float | None]] = {
     "base_radius": lambda a, s: a.design.cam.base_radius,
     "pressure_angle": lambda a, s: s["geometry"]["pressure_angle_max_deg"],
@@ -82,6 +96,9 @@ _FIGURES: dict[str, Callable[[Analysis, Mapping[str, Any]], float | None]] = {
     "roller_life_h": lambda a, s: s.get("life", {}).get("roller_life_h"),
     "min_film_ratio": lambda a, s: s.get("lubrication", {}).get("min_film_ratio"),
     "motor_rms_torque": lambda a, s: s.get("drive", {}).get("motor_rms_torque_Nm"),
+    # issue 34: the elastic follower train at the design speed, when the design has [vibration]
+    "vibration_residual_mm": lambda a, s: _residual(s),
+    "min_dynamic_contact_force": lambda a, s: s.get("vibration", {}).get("contact_force_min"),
 }
 
 MEASURES: dict[str, Measure] = {
@@ -106,6 +123,18 @@ MEASURES: dict[str, Measure] = {
             name="min_film_ratio", unit="1", column="min_film_ratio", text="smallest lubricant film ratio"
         ),
         Measure(name="motor_rms_torque", unit="N·m", column="motor_rms_torque_Nm", text="motor RMS torque"),
+        Measure(
+            name="vibration_residual_mm",
+            unit="mm",
+            column="vibration_residual_mm",
+            text="largest residual vibration in a dwell",
+        ),
+        Measure(
+            name="min_dynamic_contact_force",
+            unit="N",
+            column="min_dynamic_contact_force_N",
+            text="smallest contact force of the elastic train",
+        ),
     )
 }
 """The objectives and limit quantities by name."""
