@@ -287,7 +287,7 @@ def _constraint_names(limits: Sequence[Limit]) -> list[str]:
             names += [f"{lim.text} ({piece})" for piece in _PIECES[lim.measure.name]]
         else:
             names.append(lim.text)
-    return [*names, "curvature: convex radius − required ≥ 0 mm (no undercut)"]
+    return [*names, "curvature: convex ρ − required ≥ 0 mm"]
 
 
 def _constraints(point: _Point, limits: Sequence[Limit]) -> tuple[list[float | None], np.ndarray]:
