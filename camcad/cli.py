@@ -461,6 +461,61 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_tolerance(args: argparse.Namespace) -> int:
+    from camcad.design.schema import parse_tolerance
+    from camcad.errors import DesignError
+    from camcad.explore.tolerance import tolerance_study
+    from camcad.geometry.cam import Cam
+
+    data = _design_mapping(args.design)
+    if "tolerance" not in data:
+        raise DesignError(
+            "tolerance", f"{args.design} has no [tolerance] table; see the README's [tolerance] keys"
+        )
+    from camcad.design import load_design
+
+    design = load_design(args.design)
+    spec = parse_tolerance(data["tolerance"], design)
+
+    def report(done: int, total: int) -> None:
+        print(f"\r  {done}/{total} chunks", end="" if done < total else "\n", file=sys.stderr, flush=True)
+
+    jobs = args.jobs if args.jobs is not None else (os.cpu_count() or 1)
+    result = tolerance_study(
+        Cam.from_design(design),
+        spec,
+        args.output,
+        name=design.cam.name,
+        source=args.design,
+        fmt=args.format,
+        jobs=jobs,
+        scheduler=args.scheduler,
+        progress=None if args.quiet or not sys.stderr.isatty() else report,
+    )
+    summary = result.summary
+    unit = summary["lift_unit"]
+    for k, dwell in enumerate(summary["dwells"]):
+        text = f"dwell {k} at {dwell['angle_deg']:.1f}°: linear σ {dwell['linear']['sigma']:.4g} {unit}, "
+        text += f"worst case {dwell['linear']['worst_case']:.4g} {unit}"
+        if "monte_carlo" in dwell:
+            lo, hi = dwell["monte_carlo"]["percentiles"][0], dwell["monte_carlo"]["percentiles"][-1]
+            text += f"; Monte Carlo 99.73 % within {lo:.4g} to {hi:.4g} {unit}"
+        print(text)
+    alloc = summary["allocation"]
+    if alloc is not None:
+        largest = ", ".join(
+            f"{k} ±{v:.4g}" if v is not None else f"{k} any" for k, v in alloc["largest_tolerances"].items()
+        )
+        verdict = "meet" if alloc["given_tolerances_meet_it"] else "do not meet"
+        print(
+            f"allocation for ±{alloc['dwell_accuracy']:g} {unit} ({alloc['method']}, confidence "
+            f"{alloc['confidence']:g}): {largest}; the given tolerances {verdict} it"
+        )
+    for path in result.files:
+        print(f"wrote {path}", file=sys.stderr)
+    return EXIT_OK
+
+
 def _cmd_serve(args: argparse.Namespace) -> int:
     from camcad.errors import UsageError
     from camcad.serve import serve
@@ -611,6 +666,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="folder for sweep.parquet (or .csv) and sweep.html")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     p.set_defaults(handler=_cmd_sweep)
+
+    p = sub.add_parser(
+        "tolerance", help="tolerance study of a design's [tolerance] table (Monte Carlo or linear)"
+    )
+    p.add_argument("design", help="design file (TOML) with a [tolerance] table")
+    p.add_argument("--format", default="parquet", help="table format: parquet (default) or csv")
+    p.add_argument("--jobs", type=int, help="local worker processes (default: every core; 1: this process)")
+    p.add_argument("--scheduler", help="a Dask scheduler address, e.g. tcp://host:8786 (instead of --jobs)")
+    p.add_argument("-o", "--output", required=True, help="folder for tolerance.parquet, .json and .html")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    p.set_defaults(handler=_cmd_tolerance)
     return parser
 
 
