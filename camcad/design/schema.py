@@ -322,8 +322,8 @@ _TOLERANCED: dict[str, Tol] = {
     "face_offset": Tol.FACE_OFFSET,
     "phase_deg": Tol.PHASE,
 }
-_StudyWord = enum.Enum("_StudyWord", [("MONTE_CARLO", "monte-carlo"), ("LINEAR", "linear")])  # type: ignore[misc]
-_AllocationWord = enum.Enum("_AllocationWord", [("RSS", "rss"), ("WORST_CASE", "worst-case")])  # type: ignore[misc]
+_StudyWord = enum.Enum("_StudyWord", [("MONTE_CARLO", "monte-carlo"), ("LINEAR", "linear")])
+_AllocationWord = enum.Enum("_AllocationWord", [("RSS", "rss"), ("WORST_CASE", "worst-case")])
 _TOLERANCE_RULES: dict[str, _Rule] = {
     **{
         f"{name}_{how}": _Rule(

@@ -28,6 +28,7 @@ from camcad._typing import ArrayLike, readonly
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.made import FormError
+from camcad.motion.program import Side
 
 __all__ = ["CompensatedCam", "offset_error"]
 
@@ -55,9 +56,9 @@ class CompensatedCam(Cam):
             correction=correction,
         )
 
-    def offset(self, phi: ArrayLike, distance: float, *, side: str = "right") -> CurveSample:  # type: ignore[override]
+    def offset(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
         """The corrected profile offset outward by ``distance`` [mm] along the design's normal."""
-        base, drho, profile_at = self._base_curve(phi, side)  # type: ignore[arg-type]
+        base, drho, profile_at = self._base_curve(phi, side)
         u = np.asarray(base.phi, dtype=float)
         c0, c1, c2 = self.correction(u)
         off = distance + profile_at + c0
