@@ -461,20 +461,27 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _toml_of(path: str) -> dict[str, Any]:
+    """The TOML mapping of a design file the schema has just accepted (``tolerance``, ``inspect``)."""
+    import tomllib
+
+    data: dict[str, Any] = tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
+    return data
+
+
 def _cmd_tolerance(args: argparse.Namespace) -> int:
+    from camcad.design import load_design
     from camcad.design.schema import parse_tolerance
     from camcad.errors import DesignError
     from camcad.explore.tolerance import tolerance_study
     from camcad.geometry.cam import Cam
 
-    data = _design_mapping(args.design)
+    design = load_design(args.design)
+    data = _toml_of(args.design)
     if "tolerance" not in data:
         raise DesignError(
             "tolerance", f"{args.design} has no [tolerance] table; see the README's [tolerance] keys"
         )
-    from camcad.design import load_design
-
-    design = load_design(args.design)
     spec = parse_tolerance(data["tolerance"], design)
 
     def report(done: int, total: int) -> None:
@@ -524,7 +531,7 @@ def _inspect_band(args: argparse.Namespace, design_path: str, design: Any) -> fl
         if not (math.isfinite(args.band) and 0.0 < args.band <= 10.0):
             raise UsageError("--band", f"{args.band!r} mm is not allowed (allowed: over 0 up to 10 mm)")
         return float(args.band)
-    data = _design_mapping(design_path)
+    data = _toml_of(design_path)
     if "tolerance" in data:
         from camcad.design.schema import parse_tolerance
         from camcad.geometry.sensitivity import Tol
