@@ -89,17 +89,26 @@ def impact_speed(
         return math.nan
     program = cam.program
 
+    # The integrator asks for the cam at one time more than once (the last stage of a step and the
+    # first of the next; both events at each step's end): each is evaluated once per time.
+    motions: dict[float, tuple[float, float]] = {}
+    scales: dict[float, float] = {}
+
     def motion_at(t: float) -> tuple[float, float]:
-        m = program.evaluate(np.array([phi + omega * t]), side="right")
-        return float(m.s[0]), float(m.a[0])
+        if t not in motions:
+            m = program.evaluate(np.array([phi + omega * t]), side="right")
+            motions[t] = float(m.s[0]), float(m.a[0])
+        return motions[t]
 
     def scale(t: float) -> float:
         """The normal gap [mm] per unit of lead e: L·cos α."""
-        st = cam.state(np.array([phi + omega * t]), side="right")
-        out = math.cos(float(st.pressure_angle[0]))
-        if st.lever is not None:
-            out *= float(st.lever[0]) * _RAD_PER_DEG
-        return out
+        if t not in scales:
+            st = cam.state(np.array([phi + omega * t]), side="right")
+            out = math.cos(float(st.pressure_angle[0]))
+            if st.lever is not None:
+                out *= float(st.lever[0]) * _RAD_PER_DEG
+            scales[t] = out
+        return scales[t]
 
     def rhs(t: float, y: np.ndarray) -> list[float]:
         s, a = motion_at(t)
