@@ -239,8 +239,8 @@ def _without_rests(b: _Brackets, rests: Sequence[tuple[float, float]]) -> _Brack
     if not len(rests) or not b.x1.size:
         return b
     span = np.asarray(rests, dtype=float).reshape(-1, 2)
-    inside = ((b.x1[:, None] >= span[:, 0]) & (b.x3[:, None] <= span[:, 1])).any(axis=1)
-    return _select(b, ~inside)
+    inside: np.ndarray = np.any((b.x1[:, None] >= span[:, 0]) & (b.x3[:, None] <= span[:, 1]), axis=1)
+    return _select(b, np.logical_not(inside))
 
 
 def _select(b: _Brackets, keep: np.ndarray) -> _Brackets:
@@ -271,8 +271,10 @@ def _probe_end_gaps(f: _Picker, b: _Brackets) -> _Brackets:
     f_probes = f(probes.ravel(), np.repeat(gap, _END_PROBES.size)).reshape(probes.shape)
     pts = np.column_stack((lo, probes, hi))
     fs = np.column_stack((b.f1[gap], f_probes, b.f3[gap]))
-    j = np.argmax(fs, axis=1)
-    hit = (j > 0) & (j < pts.shape[1] - 1)
+    # a probe must beat both ends: one that only ties the end (the top of a rise, flat to round-off
+    # there) shows nothing rising above it
+    j = 1 + np.argmax(fs[:, 1:-1], axis=1)
+    hit = fs[np.arange(gap.size), j] > np.maximum(fs[:, 0], fs[:, -1])
     keep = np.ones(b.x1.size, bool)
     keep[gap[~hit]] = False
     g, jj, k = gap[hit], j[hit], np.flatnonzero(hit)
@@ -320,6 +322,8 @@ def _refine_max(f: _Picker, b: _Brackets) -> tuple[FloatArray, FloatArray]:
             u = x - num / den
         inside = np.isfinite(u) & (u > a + tol) & (u < b_ - tol)
         live &= ~(inside & (np.abs(u - x) <= _XSTOP))  # the parabola's vertex is the point itself
+        if not live.any():
+            break
         usable = inside & (np.abs(u - x) > tol) & (np.abs(u - u_prev) > tol)  # no stalling on one point
         golden = np.where(x - a > b_ - x, x - _GOLDEN_SECTION * (x - a), x + _GOLDEN_SECTION * (b_ - x))
         u = np.where(usable, u, golden)
@@ -405,7 +409,8 @@ def extremes_rows(
     ]
     br = _without_rests(_brackets(seq, val, best), rests)
     if any(settled):
-        br = _select(br, ~np.asarray(settled, dtype=bool)[br.row])
+        searched: np.ndarray = np.logical_not(np.asarray(settled, dtype=bool))[br.row]
+        br = _select(br, searched)
     picker = _Picker(quantity, sign[:, 0], br.row, k)
     br = _probe_end_gaps(picker, br)
     if br.x1.size:

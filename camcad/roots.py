@@ -103,13 +103,27 @@ def brent_roots(
         When some f(a_i) and f(b_i) have the same sign, or a bracket does not
         converge in ``max_iter`` steps.
     """
-    a = np.array(a, dtype=float).ravel()
-    b = np.array(b, dtype=float).ravel()
+    lo = np.array(a, dtype=float).ravel()
+    hi = np.array(b, dtype=float).ravel()
     if fa is None or fb is None:
-        ends = np.asarray(f(np.concatenate((a, b))), dtype=float)
-        fa, fb = ends[: a.size], ends[a.size :]
-    fa = np.array(fa, dtype=float).ravel()
-    fb = np.array(fb, dtype=float).ravel()
+        ends = np.asarray(f(np.concatenate((lo, hi))), dtype=float)
+        f_lo, f_hi = ends[: lo.size], ends[lo.size :]
+    else:
+        f_lo, f_hi = np.array(fa, dtype=float).ravel(), np.array(fb, dtype=float).ravel()
+    return _lockstep(f, lo, hi, f_lo, f_hi, xtol=xtol, max_iter=max_iter)
+
+
+def _lockstep(
+    f: Callable[[FloatArray], ArrayLike],
+    a: FloatArray,
+    b: FloatArray,
+    fa: FloatArray,
+    fb: FloatArray,
+    *,
+    xtol: float,
+    max_iter: int,
+) -> FloatArray:
+    """:func:`brent_roots` on arrays of bracket ends and the values there; the steps of :func:`brent_root`."""
     root = np.where(fa == 0.0, a, b)
     live = (fa != 0.0) & (fb != 0.0)
     bad = live & ((fa > 0.0) == (fb > 0.0))

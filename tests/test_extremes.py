@@ -134,3 +134,17 @@ def test_the_summary_is_the_same_on_every_call_and_each_copy_is_the_callers():
     first["motion"]["joints"].clear()
     assert analysis.summary()["motion"]["joints"]
     assert analysis.summary() == analyse(design, fit=False, toolpath=False, strict=False).summary()
+
+
+def test_a_probe_that_only_ties_the_end_of_a_piece_is_not_searched():
+    """s = 1 − (1 − φ)⁴ up to φ = 1 rad, then 0: flat to round-off at the top, the end's limit is the max."""
+
+    def rows(phi, side):
+        phi = np.asarray(phi, dtype=float)
+        inside = (phi < 1.0) | ((phi == 1.0) & (side == "left"))
+        return np.where(inside, 1.0 - (1.0 - phi) ** 4, 0.0)[None, :]
+
+    quantity, calls = _counting(rows)
+    (top,) = extremes_rows(quantity, GRID, [1.0], ("max",))
+    assert (top.value, top.phi, top.side) == (1.0, 1.0, "left")  # the closed form: the limit at the joint
+    assert len(calls) <= 4  # the grid, the joint's limits, the end gaps' probes: no search

@@ -183,7 +183,8 @@ class Cam:
         """
         if "kinematics" not in self._memo:
             self._memo["kinematics"] = self._follower()
-        return self._memo["kinematics"]
+        out: Follower = self._memo["kinematics"]
+        return out
 
     def _follower(self) -> Follower:
         first = follower_from_spec(self.follower, self.base_radius)
