@@ -70,10 +70,15 @@ def main() -> None:
     for n in (360, 3600):
         phi, s = table(n)
         cases.append((f"table of {n} points", lambda phi=phi, s=s: smooth_table(phi, s, noise=0.005)))
+    print("| case | best time [ms] |")
+    print("| --- | ---: |")
     for name, fn in cases:
         repeat = 1 if "360 linked" in name else 5
-        print(f"{name:<40} {1000 * best(fn, repeat):9.1f} ms")
+        print(f"| {name} | {1000 * best(fn, repeat):.1f} |")
 
 
 if __name__ == "__main__":
-    main()
+    from _readme import captured  # this folder is on sys.path when the script runs
+
+    with captured("motion-blend"):  # the printed tables become its section of benchmarks/README.md
+        main()
