@@ -1,7 +1,7 @@
 """Cost of issue 16's motion design: blend-point solves and point-table smoothing.
 
 Run ``python benchmarks/motion_blend.py``; prints the best of five wall-clock
-times per case (this project's 2-core machine: see the README).
+times per case and writes them to its section of benchmarks/README.md.
 """
 
 from __future__ import annotations

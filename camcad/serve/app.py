@@ -2,7 +2,7 @@
 
 The standard library's HTTP machinery is enough for one user on one machine
 and adds no dependency; what a server on a workstation must not allow is
-handled here (see "Security of camcad serve" in the README):
+handled here (see docs/reference/serve-security.md):
 
 - it listens on 127.0.0.1 only, and answers only requests addressed to a
   loopback name (``Host``: no DNS rebinding from a web page);

@@ -98,7 +98,7 @@ def test_the_limits_table_names_fields_the_loader_knows():
         assert (build, strict) == (("3", "3") if kind == "hard" else ("warning", "3")), row
         assert check in {"3", "not checked"}, row
         for field in re.findall(r"`([a-z_]+(?:\[i\])?\.[a-z0-9_]+)`", fields):
-            assert field in known or field in KNOWN_NOT_KEYS, f"{field} in the row {limit!r} is no key of the design file"
+            assert field in known or field in KNOWN_NOT_KEYS, f"{field} ({limit!r}): no such key"
     assert kinds == {"hard", "soft"}
 
 

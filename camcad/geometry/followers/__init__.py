@@ -6,7 +6,7 @@ frame (a roller centre or a face line, with three φ-derivatives), and it says
 how it is guided (:class:`~camcad.geometry.envelope.Guide`). Everything else
 (profile, normals, curvature, pressure angle, undercut, offsets for tools,
 sizing) is done once, for every follower, by :mod:`camcad.geometry.envelope`
-and :class:`~camcad.geometry.cam.Cam`. See the README's "Adding a follower".
+and :class:`~camcad.geometry.cam.Cam`. See "Adding a follower" in docs/reference/architecture.md.
 """
 
 from __future__ import annotations
