@@ -27,6 +27,7 @@ from camcad.positive import PositiveDrive
 
 if TYPE_CHECKING:
     from camcad.dynamics.duty import DutyResult
+    from camcad.dynamics.vibration import VibrationResult
     from camcad.export.gcode import GcodeProgram
     from camcad.fea.results import FeaResult  # only typing: the FE package loads when the check runs
     from camcad.toolpath import Toolpath
@@ -73,6 +74,7 @@ class Analysis:
     positive: PositiveDrive = field(default_factory=PositiveDrive)
     fea: FeaResult | None = None  # the finite-element check, when run ([fea] present, or asked for)
     duty: DutyResult | None = None  # life, film and drive ([life], [lubrication], [drive]; issue 35)
+    vibration: VibrationResult | None = None  # the elastic follower train ([vibration]; issue 34)
 
     @property
     def findings(self) -> tuple[Finding, ...]:
@@ -84,6 +86,7 @@ class Analysis:
             *self.stage_findings,
             *(self.fea.findings if self.fea is not None else ()),
             *(self.duty.findings if self.duty is not None else ()),
+            *(self.vibration.findings if self.vibration is not None else ()),
         )
         return tuple(sorted(found, key=lambda f: not f.hard))
 
@@ -92,7 +95,8 @@ class Analysis:
         """Every non-fatal message of every stage: soft findings and notes."""
         fea = list(self.fea.warnings) if self.fea is not None else []
         duty = [f.message for f in self.duty.findings] if self.duty is not None else []
-        return [*self.geometry.warnings, *self.dynamics.warnings, *fea, *duty]
+        vib = [f.message for f in self.vibration.findings if not f.hard] if self.vibration is not None else []
+        return [*self.geometry.warnings, *self.dynamics.warnings, *fea, *duty, *vib]
 
     @property
     def violations(self) -> list[str]:
@@ -121,6 +125,8 @@ class Analysis:
             out["fea"] = self.fea.summary()
         if self.duty is not None:
             out |= self.duty.summary()  # life, lubrication, drive
+        if self.vibration is not None:
+            out["vibration"] = self.vibration.summary()
         out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]

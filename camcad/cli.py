@@ -199,6 +199,44 @@ def _duty_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     return rows
 
 
+def _vibration_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+    """The rows ``[vibration]`` adds to ``camcad check`` (issue 34): the elastic train at the design speed."""
+    vib = summary.get("vibration")
+    if vib is None:
+        return []
+    unit = "mm" if "error_peak_mm" in vib else "deg"
+    shown = " mm" if unit == "mm" else "°"
+    force = " N" if unit == "mm" else " N·mm"
+    at = f" at {vib['speed_rpm']:g} rpm"
+    rows = [
+        ("natural frequency", ", ".join(f"{f:.4g} Hz" for f in vib["natural_frequencies_hz"])),
+        (
+            "peak dynamic error",
+            f"{vib[f'error_peak_{unit}']:.4g}{shown} at {vib['error_peak_angle_deg']:.1f}°{at}",
+        ),
+        (
+            "min dynamic contact force",
+            f"{vib['contact_force_min']:.4g}{force} at {vib['contact_force_min_angle_deg']:.1f}°{at}",
+        ),
+    ]
+    for k, value in enumerate(vib[f"residual_{unit}"], start=1):
+        rows.append((f"residual in dwell {k}", f"{value:.4g}{shown}"))
+    flights = vib["flights"]
+    leaves = "no"
+    if vib["leaves_cam"]:
+        leaves = "yes" + (f", at {flights[0]['leave_deg']:.1f}°" if flights else "")
+    rows.append(("leaves the cam", leaves))
+    if "compensate_rpm" in vib:
+        rows.append(
+            (
+                "polydyne lift correction",
+                f"max |c − s| {vib[f'lift_correction_max_{unit}']:.4g}{shown}"
+                f" (tuned for {vib['compensate_rpm']:g} rpm)",
+            )
+        )
+    return rows
+
+
 def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     """The rows a groove or a conjugate pair adds to ``camcad check``: flanks, second plate, crossovers."""
     rows: list[tuple[str, str]] = []
@@ -279,6 +317,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     analysis = analyse(design, strict=False, toolpath=False, fea=args.fea or design.fea is not None)
     rows = _check_rows(analysis.summary(), design) + _positive_rows(analysis.summary())
     rows += _duty_rows(analysis.summary())
+    rows += _vibration_rows(analysis.summary())
     if analysis.fea is not None:
         rows += _fea_rows(analysis.summary()["fea"])
     width = max(len(k) for k, _ in rows)

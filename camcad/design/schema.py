@@ -41,6 +41,7 @@ from camcad.dynamics.drive import DriveMode, DriveSpec
 from camcad.dynamics.film import LubricationSpec
 from camcad.dynamics.life import ROLLER_EXPONENT, LifeSpec, LoadStressLine
 from camcad.dynamics.spec import DynamicsModel, DynamicsSpec
+from camcad.dynamics.vibration.spec import TrainModel, VibrationSpec
 from camcad.errors import DesignError, ValueRuleError
 from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec, PlaneModel
@@ -425,6 +426,24 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "max_inertia_ratio": _Rule("float", check=_between(0.0, 1e6, "", lo_open=True)),
         "screw_lead_mm": _Rule("float", check=_length),
         "axis_friction": _Rule("float", check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N or N·mm")),
+    },
+    "vibration": {  # issue 34: the elastic follower train, speed map and polydyne cam (dynamics.vibration)
+        "model": _Rule("enum", enum=TrainModel),
+        "stiffness": _Rule("float", check=_between(0.0, MAX_FORCE_N, " N/mm", lo_open=True)),
+        "stiffness_torsional": _Rule(
+            "float", check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N·mm/rad", lo_open=True)
+        ),
+        "damping_ratio": _Rule("float", check=_fraction),
+        "mass_1": _Rule("float", check=_between(0.0, MAX_MASS_KG, " kg", lo_open=True)),
+        "mass_2": _Rule("float", check=_between(0.0, MAX_MASS_KG, " kg", lo_open=True)),
+        "stiffness_2": _Rule("float", check=_between(0.0, MAX_FORCE_N, " N/mm", lo_open=True)),
+        "speed_min_rpm": _Rule("float", check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "speed_max_rpm": _Rule("float", check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "speed_points": _Rule("int", check=_count(1, 10_000, "speeds in speed_map.csv")),
+        "compensate_rpm": _Rule("float", check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "max_residual": _Rule(
+            "float", check=_between(0.0, MAX_LENGTH_MM, " mm (degrees on an arm)", lo_open=True)
+        ),
     },
     "tables": {
         "step_deg": _Rule("float", check=_table_step, scale=DEG, attr="step"),
@@ -925,6 +944,42 @@ def _check_service(design: Design) -> None:
         )
 
 
+def _check_vibration(design: Design) -> None:
+    """``[vibration]`` (issue 34) against the follower, the drive, the speed and the laws (exit 2)."""
+    vib = design.vibration
+    if vib is None:
+        return
+    from camcad.dynamics.vibration import check_compensable, train_from_specs
+
+    arm = design.follower.kind.oscillating
+    wrong = "stiffness" if arm else "stiffness_torsional"
+    if getattr(vib, wrong) is not None:
+        right = "stiffness_torsional (N·mm/rad about the pivot)" if arm else "stiffness (N/mm)"
+        raise DesignError(
+            f"vibration.{wrong}", f"does not apply to a {design.follower.kind.value} follower; give {right}"
+        )
+    setup = design.dynamics_setup()
+    train_from_specs(vib, design.dynamics, arm_angle=setup.arm_angle)  # required keys, masses, rates
+    speed = design.cam.speed_rpm
+    lo = vib.speed_min_rpm if vib.speed_min_rpm is not None else 0.5 * speed
+    hi = vib.speed_max_rpm if vib.speed_max_rpm is not None else 1.5 * speed
+    if not lo < hi:
+        field = "speed_max_rpm" if vib.speed_max_rpm is not None else "speed_min_rpm"
+        raise DesignError(
+            f"vibration.{field}",
+            f"the speed map's range {lo:g} to {hi:g} rpm is empty (the default range is 0.5 to 1.5 times "
+            f"cam.speed_rpm = {speed:g}); allowed: speed_min_rpm < speed_max_rpm",
+        )
+    if vib.compensate_rpm is not None:
+        if setup.positive_drive:
+            raise DesignError(
+                "vibration.compensate_rpm",
+                f"a {design.cam.style.value} cam drives its follower both ways (no return spring to tune "
+                "against); allowed: compensate_rpm on a spring-loaded plate cam only",
+            )
+        check_compensable(MotionProgram.from_segments(design.motion))
+
+
 def _check_design(design: Design) -> None:
     """The checks across fields, each naming the field to change."""
     _check_follower(design)
@@ -935,6 +990,7 @@ def _check_design(design: Design) -> None:
     _check_gcode(design)
     _check_fea(design)
     _check_service(design)
+    _check_vibration(design)
 
 
 def _check_follower(design: Design) -> None:
@@ -1273,6 +1329,8 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
     if "fea" in data:  # present or not decides whether a build runs the FE check
         specs["fea"] = FeaSpec(**_section("fea", data["fea"]))
     specs |= _service_tables(data)  # [life], [lubrication], [drive] (issue 35)
+    if "vibration" in data:  # issue 34
+        specs["vibration"] = VibrationSpec(**_section("vibration", data["vibration"]))
     for table in ("groove", "conjugate"):  # after their values, so a bad value names its own key
         if table in data and specs["cam"].style.value != table:
             raise DesignError(table, f"the [{table}] table applies to cam.style = '{table}' only")
