@@ -7,6 +7,7 @@ sits below the report and the pipeline: both read it, neither is imported here.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -75,6 +76,9 @@ class Analysis:
     fea: FeaResult | None = None  # the finite-element check, when run ([fea] present, or asked for)
     duty: DutyResult | None = None  # life, film and drive ([life], [lubrication], [drive]; issue 35)
     vibration: VibrationResult | None = None  # the elastic follower train ([vibration]; issue 34)
+    _memo: dict[str, Any] = field(  # the motion summary, computed once (see summary)
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     @property
     def findings(self) -> tuple[Finding, ...]:
@@ -104,11 +108,18 @@ class Analysis:
         return list(dict.fromkeys(f.kind for f in self.findings))
 
     def summary(self) -> dict[str, Any]:
-        """The content of ``summary.json``."""
+        """The content of ``summary.json``; a new dict on each call, the caller's to change.
+
+        The motion's true peaks are refined once per analysis and copied from
+        then on: the report, its cards and its warning banner each ask for the
+        summary, and the designer draws all three after every edit.
+        """
+        if "motion" not in self._memo:
+            self._memo["motion"] = motion_summary(self.cam, self.motion)
         out: dict[str, Any] = {
             "camcad_version": __version__,
             "design": {"name": self.design.cam.name, "source": self.design.source},
-            "motion": motion_summary(self.cam, self.motion),
+            "motion": copy.deepcopy(self._memo["motion"]),
             "geometry": self.geometry.summary(),
             "dynamics": self.dynamics.summary(),
             **self.positive.summary(),
@@ -162,20 +173,14 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
 
     def rows(p: FloatArray, side: Side) -> FloatArray:
         m = cam.motion(p, side=side)
-        return np.abs(np.vstack((m.v, m.a, m.j)))
+        return np.vstack((np.abs(np.vstack((m.v, m.a, m.j))), m.s, m.s))
 
-    values = np.abs(np.vstack((motion.v, motion.a, motion.j)))
-    peaks = extremes_rows(rows, motion.phi, joints, ("max", "max", "max"), values=values)
-
-    def travel(p: FloatArray, side: Side) -> FloatArray:
-        s = cam.motion(p, side=side).s
-        return np.vstack((s, s))
-
-    # the true stroke: the follower's travel max − min over the turn, refined on the exact motion (a
-    # segment that overshoots, as a return out of a constant-velocity rise does, can exceed the lift)
-    top, bottom = extremes_rows(
-        travel, motion.phi, joints, ("max", "min"), values=np.vstack((motion.s, motion.s))
-    )
+    # |v|, |a|, |j| and the true stroke, the follower's travel max − min over the turn, refined on the
+    # exact motion in one search (a segment that overshoots, as a return out of a constant-velocity rise
+    # does, can exceed the lift)
+    values = np.vstack((np.abs(np.vstack((motion.v, motion.a, motion.j))), motion.s, motion.s))
+    found = extremes_rows(rows, motion.phi, joints, ("max", "max", "max", "max", "min"), values=values)
+    peaks, (top, bottom) = found[:3], found[3:]
     out[f"stroke_{u}"] = top.value - bottom.value
     out[f"travel_max_{u}"] = top.value
     out["travel_max_angle_deg"] = top.angle_deg

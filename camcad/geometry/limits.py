@@ -13,7 +13,7 @@ from camcad.angles import TWO_PI, flagged_ranges, format_ranges
 from camcad.errors import UndercutError
 from camcad.extremes import SIDE_WORDS, Extreme, Kind, Quantity, Side, extremes_rows
 from camcad.findings import Finding, Severity
-from camcad.geometry.cam import Cam
+from camcad.geometry.cam import Cam, CamState
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import LineElement, PointElement
 from camcad.geometry.followers.tied import TiedRoller
@@ -285,8 +285,10 @@ def analyse_geometry(
     kinds: tuple[Kind, ...] = ("max", "min", "max", "min", "min", "min", "min", "max")
 
     def rows(p: FloatArray, side: Side) -> FloatArray:
+        return rows_of(cam.state(p, side=side))
+
+    def rows_of(st: CamState) -> FloatArray:
         """|α|, profile radius (min, max), convex ρ, concave ρ, undercut quantity, contact x (min, max)."""
-        st = cam.state(p, side=side)
         radius = np.hypot(st.profile.point[:, 0], st.profile.point[:, 1])
         rho = st.profile.rho
         undercut = cam.loop_radius(st)
@@ -296,9 +298,9 @@ def analyse_geometry(
         concave = np.where(np.isfinite(undercut), np.inf, _concave(rho))
         return np.vstack((np.abs(st.pressure_angle), radius, radius, convex, concave, undercut, x, x))
 
-    values = rows(phi, "right")
+    values = rows_of(now)  # the samples: the state above, not a second evaluation
     alpha_max, radius_min, radius_max, convex_min, concave_min, worst, reach_min, reach_max = extremes_rows(
-        rows, phi, joints, kinds, values=values
+        rows, phi, joints, kinds, values=values, rests=cam.rests
     )
 
     if alpha_max.value > max_pressure_angle:

@@ -87,7 +87,11 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
     second = None
     partner = positive.partner if positive.second_plate else None
     if partner is not None:
-        outline = np.asarray(partner.profile(geo.phi).point)
+        plate = positive.partner_geometry  # its profile on the same grid, as analysed: not evaluated again
+        same = plate is not None and np.array_equal(plate.phi, geo.phi)
+        outline = np.asarray(
+            plate.profile.point if same and plate is not None else partner.profile(geo.phi).point
+        )
         second = {"profile": _xy(outline), "followers": _followers(analysis, reach, partner)}
     return {
         "groove": groove,
