@@ -67,9 +67,13 @@ def machine() -> str:
 
 
 def publish(name: str, body: str, command: str | None = None, path: Path = README) -> None:
-    """Write ``body`` (markdown) as section ``name`` of ``path``, headed by the command and the machine."""
+    """Write ``body`` (markdown) as section ``name`` of ``path``, headed by the command and the machine.
+
+    Headings in ``body`` move two levels down, below the file's own ``##`` heading of the section.
+    """
     command = command or "python " + " ".join(["benchmarks/" + Path(sys.argv[0]).name, *sys.argv[1:]])
     head = f"Written by `{command}` on {machine()}.\n\n"
+    body = re.sub(r"^(#{1,4}) ", r"\1## ", body, flags=re.MULTILINE)  # its headings nest under the section's
     old = path.read_text(encoding="utf-8") if path.exists() else ""
     new = replace_section(old, name, head + body)
     tmp = path.with_name(path.name + ".tmp")

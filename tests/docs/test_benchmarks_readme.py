@@ -71,3 +71,11 @@ def test_every_benchmark_script_writes_its_own_section(script):
     (name,) = re.findall(r'with captured\("([a-z0-9_-]+)"', source)
     readme = (ROOT / "benchmarks" / "README.md").read_text(encoding="utf-8")
     assert readme.count(f"<!-- BEGIN {name} -->") == 1 and readme.count(f"<!-- END {name} -->") == 1
+
+
+def test_a_scripts_headings_nest_under_the_sections_heading(tmp_path):
+    readme = tmp_path / "README.md"
+    bench.publish("x", "## camcad.fit at 1 µm\n\n| a |\n\n### cost\n", command="c", path=readme)
+    body = readme.read_text(encoding="utf-8")
+    assert "\n#### camcad.fit at 1 µm\n" in body and "\n##### cost\n" in body
+    assert not any(line.startswith(("## ", "### ")) for line in body.splitlines())
