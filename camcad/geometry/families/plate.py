@@ -1,0 +1,36 @@
+"""The plate cam: one plate, cut along its outline; a spring holds the follower on."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from camcad.geometry.cam import Cam
+from camcad.geometry.families.base import Drive, FamilyOptions, Part, PartResults
+
+__all__ = ["PLATE", "PlateFamily"]
+
+
+class PlateFamily:
+    """A plate cam: the designed cam is the one part."""
+
+    name = "plate"
+
+    def parts(self, cam: Cam, options: FamilyOptions) -> tuple[Part, ...]:
+        """The plate."""
+        return (Part(cam=cam),)
+
+    def drive(self, roller_radius: float, options: FamilyOptions) -> Drive:
+        """A spring holds the follower on the plate."""
+        return Drive(positive_drive=False, clearance=0.0, flank_offsets=None)
+
+    def summary(self, results: Sequence[PartResults]) -> dict[str, Any]:
+        """Nothing beyond the common sections."""
+        return {}
+
+    def caption(self, parts: Sequence[Part]) -> str:
+        """Nothing beyond the common caption."""
+        return ""
+
+
+PLATE = PlateFamily()
