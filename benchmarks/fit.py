@@ -107,7 +107,7 @@ def shipped_cams() -> list[tuple[str, np.ndarray, Exact, list[tuple[float, int]]
         return []
     out = []
     for path in sorted((root / "samples").glob("*.toml")):
-        design = camcad.load(path).design if hasattr(camcad, "load") else camcad.load_design(path)
+        design = camcad.load_design(path)
         cam = Cam.from_design(design)
         phi = np.asarray(cam.sample_phi())
         breaks = [(b.phi, b.continuity) for b in cam.program.breakpoints]

@@ -1,9 +1,12 @@
 """camcad: disc cams from motion specification to DXF, STL and G-code.
 
 >>> import camcad
->>> project = camcad.load("samples/quintero_vap_b01.toml")  # doctest: +SKIP
->>> analysis = project.analyse()  # doctest: +SKIP
->>> project.build("out/")  # doctest: +SKIP
+>>> design = camcad.load("samples/quintero_vap_b01.toml")  # doctest: +SKIP
+>>> result = camcad.analyse(design)  # doctest: +SKIP
+>>> result.build("out/")  # doctest: +SKIP
+
+The Python API (:mod:`camcad.api`): ``load``, ``analyse``, ``Design``,
+``Result``, ``optimize``, ``sweep``.
 
 Every public name is imported on first use (:func:`__getattr__`), so
 ``import camcad`` is light: ``camcad --version`` answers at once, and the
@@ -36,15 +39,22 @@ from camcad._version import __version__  # noqa: E402
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing (mypy reads it the same way)
 
 if TYPE_CHECKING:
-    from camcad.design import Design, load_design, parse_design
+    from camcad.api import Design, Quantity, Result, analyse, load, optimize, sweep
+    from camcad.design import load_design, parse_design
     from camcad.errors import CamcadError, DesignError, DesignLimitError, OutputError, UsageError
     from camcad.geometry.cam import Cam
     from camcad.motion.laws import LAWS, make_law
     from camcad.motion.program import Motion, MotionProgram
-    from camcad.pipeline import Analysis, BuildResult, Project, analyse, build, load
+    from camcad.pipeline import Analysis, BuildResult, Project, build
 
 _WHERE = {  # public name → the module that defines it
-    "Design": "camcad.design",
+    "Design": "camcad.api",
+    "Quantity": "camcad.api",
+    "Result": "camcad.api",
+    "analyse": "camcad.api",
+    "load": "camcad.api",
+    "optimize": "camcad.api",
+    "sweep": "camcad.api",
     "load_design": "camcad.design",
     "parse_design": "camcad.design",
     "CamcadError": "camcad.errors",
@@ -60,9 +70,7 @@ _WHERE = {  # public name → the module that defines it
     "Analysis": "camcad.pipeline",
     "BuildResult": "camcad.pipeline",
     "Project": "camcad.pipeline",
-    "analyse": "camcad.pipeline",
     "build": "camcad.pipeline",
-    "load": "camcad.pipeline",
 }
 
 
@@ -93,6 +101,8 @@ __all__ = [
     "MotionProgram",
     "OutputError",
     "Project",
+    "Quantity",
+    "Result",
     "UsageError",
     "__version__",
     "analyse",
@@ -100,5 +110,7 @@ __all__ = [
     "load",
     "load_design",
     "make_law",
+    "optimize",
     "parse_design",
+    "sweep",
 ]

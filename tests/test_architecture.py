@@ -6,7 +6,7 @@ The layers are those of the README's architecture section, bottom first::
       < motion < geometry < dynamics < inspect < fea < fit < toolpath < export
       < design
       < analysis, report, report_tables, _plots < pipeline < explore
-      < cli, serve, __init__, __main__
+      < cli, serve, api, __init__, __main__
 
 A module imports camcad code only from its own layer or below. The design
 schema (``camcad/design.py``, later ``design/``) sits above the stages: only
@@ -49,7 +49,8 @@ LAYER_ORDER: tuple[frozenset[str], ...] = (
     frozenset({"analysis", "report", "report_tables", "_plots"}),
     frozenset({"pipeline"}),
     frozenset({"explore"}),  # camcad/explore/ (issue 20): optimise, sweep, Pareto; analyses through pipeline
-    frozenset({"cli", "serve", "__init__", "__main__"}),  # serve/ (issue 19): the live designer
+    # serve/ (issue 19): the live designer; api: the Python API (issue 39)
+    frozenset({"cli", "serve", "api", "__init__", "__main__"}),
 )
 LAYERS: dict[str, int] = {name: rank for rank, names in enumerate(LAYER_ORDER) for name in names}
 DESIGN_READERS_FROM = LAYERS["analysis"]  # this layer and those above may import design

@@ -30,6 +30,7 @@ STRICT_TYPED = (
     "camcad/errors.py",
     "camcad/_typing.py",
     "camcad/_lazy.py",
+    "camcad/api.py",
 )
 
 

@@ -17,6 +17,7 @@ import camcad
 from camcad._plots.design import follower_drawings, profile_plot
 from camcad.analysis import Analysis
 from camcad.geometry.groove import groove_flanks
+from camcad.pipeline import analyse
 from tests.conftest import ROOT, distance_to_polygon
 
 DENSE = np.linspace(0.0, 2.0 * math.pi, 200_000, endpoint=False)
@@ -24,7 +25,7 @@ DENSE = np.linspace(0.0, 2.0 * math.pi, 200_000, endpoint=False)
 
 @cache
 def analysed(sample: str) -> Analysis:
-    return camcad.load(ROOT / "samples" / sample).analyse(fit=False, toolpath=False)
+    return analyse(camcad.load_design(ROOT / "samples" / sample), fit=False, toolpath=False)
 
 
 def _centres(drawings) -> np.ndarray:
