@@ -8,7 +8,6 @@ the output folder only when every stage has succeeded.
 
 from __future__ import annotations
 
-import math
 import os
 import pickle
 import re
@@ -21,14 +20,12 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from camcad.analysis import Analysis, PartResult, motion_summary
 from camcad.design import Design, load_design
 from camcad.dynamics import DynamicsResult, analyse_dynamics
 from camcad.errors import DesignLimitError, ExportError, FitError, GougeError, UsageError
 from camcad.export.atomic import staged_folder
-from camcad.export.records import write_csv, write_json, write_text
+from camcad.export.records import write_json, write_text
 from camcad.findings import Finding, Severity
 from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.geometry import Cam, GeometryAnalysis, analyse_geometry, undercut_error
@@ -68,8 +65,6 @@ OUTPUT_GROUPS: dict[str, tuple[str, ...]] = {
     "report": ("report.html",),
 }
 """What ``build --only`` selects; ``summary.json`` is always written."""
-
-MOTION_TABLE_STEP_DEG = 0.1
 
 
 def load(path: str | Path) -> Project:
@@ -621,49 +616,20 @@ def _fitted(result: PartResult) -> ProfileFit:
 
 def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
     """motion.csv, profile.csv, dynamics.csv, points.csv and lift.csv into ``folder``."""
-    from camcad.export.tables import write_lift_csv, write_points_csv
+    from camcad.export.tables import (
+        write_dynamics_csv,
+        write_lift_csv,
+        write_motion_csv,
+        write_points_csv,
+        write_profile_csv,
+    )
 
-    cam, geo, design = analysis.cam, analysis.geometry, analysis.design
-    step = math.radians(MOTION_TABLE_STEP_DEG)
-    grid = np.arange(round(2 * math.pi / step)) * step
-    m = cam.motion(grid)
-    u = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
-    motion_csv = write_csv(
-        folder / "motion.csv",
-        {
-            "angle_deg": np.degrees(grid),
-            f"s_{u}": m.s,
-            f"v_{u}_per_rad": m.v,
-            f"a_{u}_per_rad2": m.a,
-            f"j_{u}_per_rad3": m.j,
-        },
-    )
-    profile_csv = write_csv(
-        folder / "profile.csv",
-        {
-            "angle_deg": np.degrees(geo.phi),
-            "pitch_x": geo.pitch.point[:, 0],
-            "pitch_y": geo.pitch.point[:, 1],
-            "x": geo.profile.point[:, 0],
-            "y": geo.profile.point[:, 1],
-            "nx": geo.profile.normal[:, 0],
-            "ny": geo.profile.normal[:, 1],
-            "pressure_angle_deg": np.degrees(geo.pressure_angle),
-            "rho_pitch_mm": geo.pitch.rho,
-            "rho_profile_mm": geo.profile.rho,
-        },
-    )
-    dyn = analysis.dynamics
-    dynamics_csv = write_csv(
-        folder / "dynamics.csv",
-        {
-            "angle_deg": np.degrees(dyn.phi),
-            "contact_force_N": dyn.contact_force,
-            "torque_Nmm": dyn.torque,
-            "hertz_stress_MPa": dyn.hertz_stress,
-            **(analysis.duty.csv_columns() if analysis.duty is not None else {}),
-        },
-    )
+    cam, design = analysis.cam, analysis.design
+    unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    duty = analysis.duty.csv_columns() if analysis.duty is not None else None  # life, film, drive columns
+    motion_csv = write_motion_csv(folder / "motion.csv", cam, unit=unit)
+    profile_csv = write_profile_csv(folder / "profile.csv", analysis.geometry)
+    dynamics_csv = write_dynamics_csv(folder / "dynamics.csv", analysis.dynamics, extra=duty)
     return [
         motion_csv,
         profile_csv,
