@@ -66,7 +66,7 @@ KNOWN_CYCLES: dict[tuple[str, ...], str] = {}
 
 # A cam family (plate, groove, conjugate; barrel later) is one module under geometry/families/: no
 # code elsewhere asks which family a cam is. The files that still do are listed, each with its
-# reason; the list only shrinks (an entry whose branch is gone fails too).
+# reason; the list only shrinks (an entry whose branch is gone fails too). It is empty.
 FAMILY_HOME = PACKAGE / "geometry" / "families"
 FAMILY_BRANCH = re.compile(
     r"CamStyle\.(?:GROOVE|CONJUGATE)\b"  # a family named by its enum member (PLATE is the default)
@@ -75,10 +75,7 @@ FAMILY_BRANCH = re.compile(
     r"|\.style\.value\s*(?:==|!=)"
     r"|\bcamcad\.positive\b|\bfrom\s+camcad\s+import\s+positive\b"  # the second pipeline, gone
 )
-KNOWN_FAMILY_BRANCHES: dict[str, str] = {
-    "camcad/design/schema.py": "cross-field rules of the TOML (a groove's outer_radius, a pair's roller, "
-    "the [groove]/[conjugate] tables, FE and rotary on plates only) are not yet declared by the families",
-}
+KNOWN_FAMILY_BRANCHES: dict[str, str] = {}  # empty
 
 
 def _module_name(path: Path) -> str:

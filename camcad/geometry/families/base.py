@@ -185,6 +185,30 @@ class CamFamily(Protocol):
         """The TOML ``cam.style`` of the family."""
         ...
 
+    @property
+    def table(self) -> str | None:
+        """The TOML table only this family reads (``[groove]``, ``[conjugate]``), or None."""
+        ...
+
+    @property
+    def needs_roller(self) -> bool:
+        """Whether the family drives its follower through a roller (positive drive does)."""
+        ...
+
+    @property
+    def one_plate(self) -> bool:
+        """Whether the family makes one plate cut along its outline (the FE check, the rotary machine)."""
+        ...
+
+    def check(
+        self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
+    ) -> None:
+        """Raise :class:`~camcad.errors.DesignError` (naming its field) where the design cannot be made.
+
+        ``base_radius``, ``roller_radius`` (the designed follower's) and ``thickness`` in mm.
+        """
+        ...
+
     def parts(self, cam: Cam, options: FamilyOptions) -> tuple[Part, ...]:
         """The parts to make of ``cam``, the designed one first."""
         ...

@@ -23,6 +23,14 @@ class ConjugateFamily:
     """A conjugate pair: the designed plate and the second plate with its own roller."""
 
     name = "conjugate"
+    table = "conjugate"
+    needs_roller = True
+    one_plate = False
+
+    def check(
+        self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
+    ) -> None:
+        """Nothing beyond the roller; a constant-breadth pair's program is the design schema's check."""
 
     def parts(self, cam: Cam, options: FamilyOptions) -> tuple[Part, ...]:
         """Plate 1, then plate 2 (``_2``), which drives the second roller."""

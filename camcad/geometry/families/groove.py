@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
 from camcad.geometry.families.base import Drive, FamilyOptions, Flank, Part, PartResults, Pocket
 from camcad.geometry.groove import analyse_groove, roller_flank_offsets
@@ -24,6 +25,27 @@ class GrooveFamily:
     """A groove cam: one part, the blank with the groove's two flanks."""
 
     name = "groove"
+    table = "groove"
+    needs_roller = True
+    one_plate = False
+
+    def check(
+        self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
+    ) -> None:
+        """A groove needs its blank, room for the groove in it, and a depth less than its thickness."""
+        outer, depth = options.outer_radius, options.groove.depth
+        if outer is None:
+            raise DesignError("cam.outer_radius", "is required for a groove cam (mm, the blank's radius)")
+        if outer <= base_radius + 2.0 * roller_radius:
+            raise DesignError(
+                "cam.outer_radius",
+                f"{outer:g} mm leaves no room for the groove; allowed: > base_radius + 2 × "
+                f"roller_radius = {base_radius + 2.0 * roller_radius:g} mm",
+            )
+        if depth >= thickness:
+            raise DesignError(
+                "groove.depth", f"{depth:g} mm must be less than the blank's thickness {thickness:g} mm"
+            )
 
     def parts(self, cam: Cam, options: FamilyOptions) -> tuple[Part, ...]:
         """The blank with its groove, checked (:func:`camcad.geometry.groove.analyse_groove`)."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
 from camcad.geometry.families.base import Drive, FamilyOptions, Part, PartResults
 
@@ -15,6 +16,16 @@ class PlateFamily:
     """A plate cam: the designed cam is the one part."""
 
     name = "plate"
+    table = None
+    needs_roller = False
+    one_plate = True
+
+    def check(
+        self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
+    ) -> None:
+        """A plate has no blank round it."""
+        if options.outer_radius is not None:
+            raise DesignError("cam.outer_radius", "applies to groove cams (cam.style = 'groove') only")
 
     def parts(self, cam: Cam, options: FamilyOptions) -> tuple[Part, ...]:
         """The plate."""
