@@ -33,6 +33,7 @@ __all__ = [
     "OutputError",
     "UndercutError",
     "UsageError",
+    "ValueRuleError",
     "exit_code",
     "printable",
 ]
@@ -95,6 +96,10 @@ class DesignError(CamcadError, ValueError):
 
 class UsageError(DesignError):
     """A command-line option has a value that is not allowed (CLI exit 2); ``path`` is the option."""
+
+
+class ValueRuleError(DesignError):
+    """A design value breaks its key's own rule (type, range, word), the rule ``camcad schema`` states too."""
 
 
 # What to do about an operating-system error while writing output, by errno.

@@ -3,25 +3,32 @@
 Editors that read JSON Schema for TOML (VS Code with Even Better TOML, any
 editor with the Taplo language server) then complete keys, offer the allowed
 words and flag a value out of range while the file is typed. The schema is
-generated from the same rules :func:`camcad.design.parse_design` checks (one
-per key in :mod:`camcad.design.schema`): the type and the enum members come
-from the rule, the range and unit from the rule's own refusal of values it
-cannot accept ("allowed: 0.1 to 10000 mm"), so the two cannot drift apart.
+generated from the same rule table :func:`camcad.design.parse_design` checks
+(one rule per key in :mod:`camcad.design.schema`, and one per law parameter):
+the type and the words come from the rule, the bounds (open or closed, "0 or
+a range", odd integers, list lengths) from the JSON Schema keywords each
+check declares beside its test, so the two cannot drift apart.
 Cross-field checks (a face width that covers the contact's travel, a lift
 that closes) remain the loader's: the schema catches what one key alone can.
 """
 
 from __future__ import annotations
 
-import re
+from collections.abc import Mapping
 from typing import Any
 
-from camcad.design.schema import _SECTIONS  # the loader's rules, read only
-from camcad.motion.laws import LAWS
+from camcad.design.schema import (  # the loader's rules, read only
+    _BOUNDARY_RULE,
+    _LAW_RULES,
+    _MOTION_RULES,
+    _SECTIONS,
+    _TABLE_ANGLE_RULE,
+    _Rule,
+)
 
-__all__ = ["design_json_schema"]
+__all__ = ["design_json_schema", "rule_schema"]
 
-_KINDS = {
+_KINDS: dict[str, dict[str, Any]] = {
     "float": {"type": "number"},
     "int": {"type": "integer"},
     "bool": {"type": "boolean"},
@@ -29,98 +36,71 @@ _KINDS = {
     "strlist": {"type": "array", "items": {"type": "string"}},
     "floatlist": {"type": "array", "items": {"type": "number"}},
 }
-_PROBES = (-1e300, 1e300, -1.0, 0.0)
-_NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
-_UNITS = {"degrees": "°", "mm": "mm", "rpm": "rpm", "N": "N", "MPa": "MPa", "kg": "kg"}
 
 
-def _refusals(rule: Any) -> list[str]:
-    said = []
-    for probe in _PROBES:
-        value: float | int = int(probe) if rule.kind == "int" and abs(probe) < 1e18 else probe
-        try:
-            text = rule.check(value)
-        except (TypeError, ValueError, OverflowError):
-            continue
-        if text:
-            said.append(text)
-    return said
+def _merge(base: dict[str, Any], extra: Mapping[str, Any]) -> dict[str, Any]:
+    """``base`` with the keywords of ``extra``; ``items`` are merged one level down."""
+    out = dict(base)
+    for key, value in extra.items():
+        if key == "items" and isinstance(out.get("items"), dict):
+            out["items"] = {**out["items"], **value}
+        else:
+            out[key] = value
+    return out
 
 
-def _range(text: str) -> tuple[dict[str, Any], str]:
-    """JSON Schema bounds and the allowed text of a rule's refusal ("allowed: 0.1 to 10000 mm")."""
-    allowed = text.split("allowed:", 1)[1].strip().rstrip(")") if "allowed:" in text else text
-    allowed = allowed.removeprefix("must be ").strip()
-    n = _NUMBER
-    bounds: dict[str, Any] = {}
-    if m := re.fullmatch(rf"(0, or )?({n}) to ({n})\b.*", allowed):
-        bounds = {"minimum": float(m.group(2)), "maximum": float(m.group(3))}
-        if m.group(1):
-            return {"anyOf": [{"const": 0}, bounds]}, allowed
-    elif m := re.fullmatch(rf"over ({n}) up to ({n})\b.*", allowed):
-        bounds = {"exclusiveMinimum": float(m.group(1)), "maximum": float(m.group(2))}
-    elif m := re.fullmatch(rf"in ([\[(])({n}), ({n})([\])]).*", allowed):
-        lo, hi = float(m.group(2)), float(m.group(3))
-        bounds = {"minimum" if m.group(1) == "[" else "exclusiveMinimum": lo}
-        bounds["maximum" if m.group(4) == "]" else "exclusiveMaximum"] = hi
-    return bounds, allowed
-
-
-def _property(rule: Any) -> dict[str, Any]:
+def rule_schema(rule: _Rule) -> dict[str, Any]:
+    """The JSON Schema of one key: its rule's type, words, and the keywords its check declares."""
     if rule.enum is not None:
         return {"enum": [str(m.value) for m in rule.enum], "description": "one of the listed words"}
-    prop: dict[str, Any] = dict(_KINDS.get(rule.kind, {}))
-    if rule.check is None or rule.kind not in ("float", "int"):
-        return prop
-    said = _refusals(rule)
-    text = next((t for t in said if "allowed" in t), said[0] if said else "")
-    bounds, allowed = _range(text)
-    if "anyOf" in bounds:
-        prop["anyOf"] = [{**_KINDS[rule.kind], **b} for b in bounds["anyOf"]]
-        prop.pop("type", None)
-    else:
-        prop.update(bounds)
-    if allowed:
-        prop["description"] = f"allowed: {allowed}"
+    prop = dict(_KINDS[rule.kind])
+    if rule.check is not None:
+        prop = _merge(prop, rule.check.schema)
+        if "anyOf" in prop:  # "0, or lo to hi": the type goes into each branch
+            kind = prop.pop("type")
+            prop["anyOf"] = [{"type": kind, **branch} for branch in prop["anyOf"]]
+        if rule.check.allowed:
+            prop["description"] = f"allowed: {rule.check.allowed}"
     return prop
+
+
+def _or_word(schema: dict[str, Any], word: str, description: str) -> dict[str, Any]:
+    return {"anyOf": [schema, {"const": word}], "description": description}
 
 
 def _motion_item() -> dict[str, Any]:
     params: dict[str, Any] = {}
-    for info in LAWS.values():
-        for p in info.parameters:
-            params.setdefault(p.name, {"type": "number", "description": f"{info.name}: {p.allowed}"})
+    laws: list[dict[str, Any]] = []
+    for law, rules in _LAW_RULES.items():
+        for name, rule in rules.items():
+            params.setdefault(name, {"type": _KINDS[rule.kind]["type"]})
+        laws.append(
+            {
+                "if": {"properties": {"law": {"const": law}}, "required": ["law"]},
+                "then": {"properties": {name: rule_schema(rule) for name, rule in rules.items()}},
+            }
+        )
+    boundary = {
+        "type": "object",
+        "properties": {
+            k: _or_word(rule_schema(_BOUNDARY_RULE), "match", "a number, or match") for k in "vaj"
+        },
+        "additionalProperties": False,
+        "description": 'blend boundary values { v, a, j }: numbers or "match"',
+    }
+    props: dict[str, Any] = {key: rule_schema(rule) for key, rule in _MOTION_RULES.items()}
+    props["lift"] = _or_word(props["lift"], "close", 'mm (degrees of swing for an arm), or "close"')
+    table = {
+        "if": {"properties": {"kind": {"const": "table"}}, "required": ["kind"]},
+        "then": {"properties": {"angle": rule_schema(_TABLE_ANGLE_RULE), "law": {"const": "table"}}},
+    }
     return {
         "type": "object",
         "description": "one segment of the motion program, in order from φ = 0",
-        "properties": {
-            "kind": {"enum": ["rise", "return", "dwell", "table"]},
-            "angle": {
-                "type": "number",
-                "exclusiveMinimum": 0,
-                "maximum": 360,
-                "description": "degrees of cam rotation",
-            },
-            "lift": {
-                "anyOf": [{"type": "number", "exclusiveMinimum": 0}, {"const": "close"}],
-                "description": 'mm (degrees of swing for an arm), or "close"',
-            },
-            "law": {"enum": [*LAWS, "table"], "description": "see `camcad laws`"},
-            "velocity": {
-                "type": "number",
-                "description": "constant-velocity only: instead of lift, per second",
-            },
-            "start": {"type": "object", "description": 'blend start values { v, a, j } or "match"'},
-            "end": {"type": "object", "description": 'blend end values { v, a, j } or "match"'},
-            "file": {
-                "type": "string",
-                "description": "kind = 'table': the CSV of angle [°], lift[, velocity]",
-            },
-            "noise": {"type": "number", "description": "kind = 'table': measurement noise σ (mm)"},
-            **params,
-        },
+        "properties": {**props, "start": boundary, "end": boundary, **params},
         "required": ["kind"],
         "additionalProperties": False,
+        "allOf": [table, *laws],
     }
 
 
@@ -128,7 +108,7 @@ def design_json_schema() -> dict[str, Any]:
     """The JSON Schema (draft 2020-12) of a camcad design file."""
     properties: dict[str, Any] = {}
     for section, rules in _SECTIONS.items():
-        props = {key: _property(rule) for key, rule in rules.items()}
+        props = {key: rule_schema(rule) for key, rule in rules.items()}
         required = [key for key, rule in rules.items() if rule.required]
         table: dict[str, Any] = {"type": "object", "properties": props, "additionalProperties": False}
         if required:

@@ -36,14 +36,16 @@ from typing import Any
 import numpy as np
 
 from camcad.design.spec import DEG, CamSpec, Design, Dialect, Direction, GcodeSpec
+from camcad.design.table_file import read_table_file
 from camcad.dynamics.drive import DriveMode, DriveSpec
 from camcad.dynamics.film import LubricationSpec
 from camcad.dynamics.life import ROLLER_EXPONENT, LifeSpec, LoadStressLine
 from camcad.dynamics.spec import DynamicsModel, DynamicsSpec
-from camcad.errors import DesignError
+from camcad.errors import DesignError, ValueRuleError
 from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec, PlaneModel
 from camcad.fit.spec import FitSpec
+from camcad.geometry.cam import Cam
 from camcad.geometry.families import FAMILIES, FamilyOptions, family_of
 from camcad.geometry.spec import (
     CamStyle,
@@ -54,11 +56,18 @@ from camcad.geometry.spec import (
     Rotation,
     arm_problem,
 )
+from camcad.motion._blendlaws import MAX_POLYNOMIAL_DEGREE
 from camcad.motion.blend import resolve_blends
-from camcad.motion.laws import LAWS, make_law
+from camcad.motion.laws import DUDLEY_MAX_DEGREE, LAWS, make_law
 from camcad.motion.program import MotionProgram
 from camcad.motion.segments import Boundary, SegmentKind, SegmentSpec
-from camcad.motion.table import parse_table_text, smooth_table
+from camcad.motion.table import (
+    FLAG_SIGMAS,
+    SCATTER_MIN_POINTS,
+    parse_table_text,
+    smooth_table,
+    table_scatter,
+)
 from camcad.toolpath.spec import Cutter, Machine, RotaryAxis
 
 if sys.version_info >= (3, 11):
@@ -71,19 +80,18 @@ __all__ = ["load_design", "parse_design"]
 FULL_TURN_DEG = 360.0
 ANGLE_SUM_TOL_DEG = 1e-9
 LIFT_CLOSE_TOL_MM = 1e-9
+SCATTER_PER_NOISE = 1.5  # a long table scattering more than this × its stated noise is refused (at 2.2× a
+# 36 000-row table ran past 120 s; at 1.46×, 7 s)
 
 # ---------------------------------------------------------------------------
 # schema: one rule per key; the rule converts and checks the TOML value
-
-
-Check = Callable[[Any], str | None]
 
 
 @dataclass(frozen=True, slots=True)
 class _Rule:
     kind: str  # "float", "int", "bool", "str", "enum", "strlist"
     required: bool = False
-    check: Check | None = None
+    check: _Check | None = None
     scale: float = 1.0  # multiply floats by this (degrees -> rad)
     enum: type[enum.Enum] | None = None
     attr: str | None = None  # dataclass attribute name when it differs from the key
@@ -129,7 +137,25 @@ _REPR = reprlib.Repr()
 _REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 2, 60, 60, 6, 6
 
 
-def _between(lo: float, hi: float, unit: str = "", *, zero: bool = False, lo_open: bool = False) -> Check:
+@dataclass(frozen=True, slots=True)
+class _Check:
+    """A key's own rule: the loader's test and the same rule as JSON Schema keywords.
+
+    ``test`` returns why a value is refused (None: allowed); ``schema`` holds
+    the JSON Schema keywords that state the same set of values, so that
+    ``camcad schema`` is generated from this table and cannot drift from it.
+    """
+
+    test: Callable[[Any], str | None]
+    schema: Mapping[str, Any]
+    allowed: str = ""
+
+    def __call__(self, value: Any) -> str | None:
+        """Why ``value`` is refused, or None."""
+        return self.test(value)
+
+
+def _between(lo: float, hi: float, unit: str = "", *, zero: bool = False, lo_open: bool = False) -> _Check:
     """Check ``lo ≤ v ≤ hi`` (``lo < v`` when ``lo_open``; also ``v == 0`` when ``zero``)."""
     low = f"> {lo:g}" if lo_open else f"≥ {lo:g}"
     span = f"over {lo:g} up to {hi:g}" if lo_open else f"{lo:g} to {hi:g}"
@@ -148,7 +174,25 @@ def _between(lo: float, hi: float, unit: str = "", *, zero: bool = False, lo_ope
             head = f"must be {low}"
         return f"{head} (allowed: {allowed})"
 
-    return check
+    bounds: dict[str, Any] = {"exclusiveMinimum" if lo_open else "minimum": lo, "maximum": hi}
+    schema: dict[str, Any] = {"anyOf": [{"const": 0}, bounds]} if zero else bounds
+    return _Check(check, schema, allowed)
+
+
+def _interval(lo: float, hi: float, unit: str = "", *, lo_open: bool, hi_open: bool, why: str = "") -> _Check:
+    """Check v in the interval from ``lo`` to ``hi``, each end open or closed: "must be in [lo, hi) unit"."""
+    text = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+
+    def check(v: float) -> str | None:
+        above = v > lo if lo_open else v >= lo
+        below = v < hi if hi_open else v <= hi
+        return None if above and below else f"must be in {text}{unit}{why}"
+
+    schema = {
+        "exclusiveMinimum" if lo_open else "minimum": lo,
+        "exclusiveMaximum" if hi_open else "maximum": hi,
+    }
+    return _Check(check, schema, f"{text}{unit}")
 
 
 _length = _between(MIN_LENGTH_MM, MAX_LENGTH_MM, " mm")
@@ -160,7 +204,7 @@ _segment_angle = _between(MIN_SEGMENT_DEG, FULL_TURN_DEG + ANGLE_SUM_TOL_DEG, " 
 _modulus = _between(MIN_MODULUS_MPA, MAX_MODULUS_MPA, " MPa")
 
 
-def _name(v: str) -> str | None:
+def _name_test(v: str) -> str | None:
     if len(v) > MAX_NAME_CHARS:
         return f"is longer than {MAX_NAME_CHARS} characters"
     try:
@@ -170,31 +214,21 @@ def _name(v: str) -> str | None:
     return None
 
 
-def _fraction(v: float) -> str | None:
-    return None if 0 <= v < 1 else "must be in [0, 1)"
+_name = _Check(_name_test, {"maxLength": MAX_NAME_CHARS}, f"at most {MAX_NAME_CHARS} characters")
+_fraction = _interval(0.0, 1.0, lo_open=False, hi_open=True)
+_poisson = _interval(0.0, 0.5, lo_open=False, hi_open=True)
 
 
-def _poisson(v: float) -> str | None:
-    return None if 0 <= v < 0.5 else "must be in [0, 0.5)"
+def _below(limit: float, unit: str, *, low: float = 0.0, why: str = "") -> _Check:
+    """``low ≤ v < limit`` when ``low``, else ``0 < v < limit``: "must be in [low, limit) unit"."""
+    return _interval(low, limit, f" {unit}", lo_open=not low, hi_open=True, why=why)
 
 
-def _below(limit: float, unit: str, *, low: float = 0.0, why: str = "") -> Check:
-    def check(v: float) -> str | None:
-        if low and low <= v < limit:
-            return None
-        if not low and 0 < v < limit:
-            return None
-        allowed = f"[{low:g}, {limit:g})" if low else f"(0, {limit:g})"
-        return f"must be in {allowed} {unit}{why}"
-
-    return check
-
-
-def _count(lo: int, hi: int, why: str) -> Check:
+def _count(lo: int, hi: int, why: str) -> _Check:
     def check(v: int) -> str | None:
         return None if lo <= v <= hi else f"must be {lo} to {hi} ({why})"
 
-    return check
+    return _Check(check, {"minimum": lo, "maximum": hi}, f"{lo} to {hi} ({why})")
 
 
 _sample_step = _below(
@@ -214,30 +248,61 @@ _table_step = _below(
 MAX_FEA_ANGLES = 36  # [fea].angles: one FE solve each
 
 
-def _fea_angles(v: tuple[float, ...]) -> str | None:
+def _fea_angles_test(v: tuple[float, ...]) -> str | None:
     if len(v) > MAX_FEA_ANGLES:
         return f"lists {len(v)} angles; allowed: at most {MAX_FEA_ANGLES} (one FE solve each)"
     bad = [a for a in v if not 0.0 <= a <= FULL_TURN_DEG]
     return f"has {bad[0]:g}; allowed: cam angles 0 to 360 degrees" if bad else None
 
 
-def _life_exponent(v: float) -> str | None:
+def _life_exponent_test(v: float) -> str | None:
     """ISO 281: p = 3 (ball) or 10/3 (needle and roller; 3.333 in a file is read as 10/3)."""
-    if v == 3.0 or abs(v - ROLLER_EXPONENT) < 1e-3:
+    if v == 3.0 or ROLLER_EXPONENT - 1e-3 < v < ROLLER_EXPONENT + 1e-3:  # the schema's bounds, exactly
         return None
     return "must be 3 (ball bearing) or 10/3 ≈ 3.333 (needle or roller bearing, ISO 281)"
 
 
+_life_exponent = _Check(
+    _life_exponent_test,
+    {
+        "anyOf": [
+            {"const": 3},
+            {"exclusiveMinimum": ROLLER_EXPONENT - 1e-3, "exclusiveMaximum": ROLLER_EXPONENT + 1e-3},
+        ]
+    },
+    "3 (ball bearing) or 10/3 ≈ 3.333 (needle or roller bearing, ISO 281)",
+)
+
+
+_fea_angles = _Check(
+    _fea_angles_test,
+    {"maxItems": MAX_FEA_ANGLES, "items": {"type": "number", "minimum": 0.0, "maximum": FULL_TURN_DEG}},
+    f"at most {MAX_FEA_ANGLES} cam angles, 0 to 360 degrees",
+)
+
 _MESH_FORMATS = ("stl", "obj", "ply", "off", "3mf", "vtu")
 
 
-def _mesh_formats(v: list[str]) -> str | None:
+def _mesh_formats_test(v: list[str]) -> str | None:
     bad = [f for f in v if f not in _MESH_FORMATS]
     if bad:
         return f"unknown format {bad[0]!r}; allowed: {', '.join(_MESH_FORMATS)}"
     if not v:
         return "must list at least one format"
     return None
+
+
+def _any_case(words: tuple[str, ...]) -> str:
+    """A JSON Schema (ECMA 262) pattern for ``words`` in any letter case (the loader lowercases them)."""
+    alts = ["".join(f"[{c.lower()}{c.upper()}]" if c.isalpha() else re.escape(c) for c in w) for w in words]
+    return f"^(?:{'|'.join(alts)})$"
+
+
+_mesh_formats = _Check(
+    _mesh_formats_test,
+    {"minItems": 1, "items": {"type": "string", "pattern": _any_case(_MESH_FORMATS)}},
+    f"one or more of {', '.join(_MESH_FORMATS)}",
+)
 
 
 _SECTIONS: dict[str, dict[str, _Rule]] = {
@@ -313,9 +378,7 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
     },
     "fit": {
         "tolerance": _Rule("float", check=_between(MIN_FIT_TOL_MM, MAX_TOLERANCE_MM, " mm")),
-        "max_control_points": _Rule(
-            "int", check=lambda v: None if 8 <= v <= 100_000 else "must be in [8, 100000]"
-        ),
+        "max_control_points": _Rule("int", check=_interval(8, 100_000, lo_open=False, hi_open=False)),
     },
     "dxf": {
         "pitch_curve": _Rule("bool"),
@@ -416,6 +479,63 @@ _SPEC_CLASSES: dict[str, type] = {
 _MOTION_KEYS = ("kind", "angle", "lift", "law")
 
 
+def _odd(lo: int, hi: int) -> _Check:
+    allowed = f"an odd integer {lo} to {hi}"
+
+    def check(v: int) -> str | None:
+        return None if lo <= v <= hi and v % 2 == 1 else f"must be {allowed}"
+
+    return _Check(check, {"minimum": lo, "maximum": hi, "not": {"multipleOf": 2}}, allowed)
+
+
+def _full_turn(v: float) -> str | None:
+    return None if v == FULL_TURN_DEG else "must be 360: a point table covers the whole turn"
+
+
+_LawName = enum.Enum("_LawName", [(name, name) for name in (*LAWS, "table")])  # type: ignore[misc]
+
+_MOTION_RULES: dict[str, _Rule] = {
+    "kind": _Rule("enum", enum=SegmentKind),
+    "law": _Rule("enum", enum=_LawName),
+    "angle": _Rule("float", check=_segment_angle),
+    "lift": _Rule("float", check=_length),  # or "close"
+    "velocity": _Rule("float", check=_between(1e-6, 1e7, " per second")),
+    "file": _Rule("str"),
+    "noise": _Rule("float", check=_between(1e-6, 10.0, " mm")),
+}
+"""The rules of a ``[[motion]]`` table's own keys (a law's parameters: ``_LAW_RULES``)."""
+_BOUNDARY_RULE = _Rule("float", check=_between(-1e9, 1e9))  # start/end = { v, a, j }: a number or "match"
+_TABLE_ANGLE_RULE = _Rule("float", check=_Check(_full_turn, {"const": FULL_TURN_DEG}, "360"))
+
+
+def _law_rule(kind: str, law: str, name: str, check: _Check) -> _Rule:
+    """A law parameter's rule, its refusal ending in the registry's own allowed text (``camcad laws``)."""
+    (said,) = (p.allowed for p in LAWS[law].parameters if p.name == name)
+
+    def test(v: Any) -> str | None:
+        problem = check(v)
+        return None if problem is None else f"{problem}; allowed: {said}"
+
+    return _Rule(kind, check=_Check(test, check.schema, said))
+
+
+_LAW_RULES: dict[str, dict[str, _Rule]] = {
+    "dudley": {"degree": _law_rule("int", "dudley", "degree", _odd(3, DUDLEY_MAX_DEGREE))},
+    "modified-sine-cv": {
+        "cv": _law_rule("float", "modified-sine-cv", "cv", _interval(0.0, 1.0, lo_open=False, hi_open=True))
+    },
+    "vap": {"b": _law_rule("float", "vap", "b", _interval(0.0, 1.0, lo_open=True, hi_open=True))},
+    "polynomial": {
+        "degree": _law_rule("int", "polynomial", "degree", _between(5, MAX_POLYNOMIAL_DEGREE, zero=True))
+    },
+}
+"""The rules of each law's parameters (their names are the registry's, ``camcad.motion.laws.LAWS``).
+
+The laws check their parameters again when built; these rules come first so
+that the loader and ``camcad schema`` state the same ranges.
+"""
+
+
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]{1,60}")
 
 
@@ -434,43 +554,43 @@ def _suggest(key: object, allowed: list[str]) -> str:
 
 def _to_float(path: str, rule: _Rule, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise DesignError(path, f"expected a number, got {_show(value)}")
+        raise ValueRuleError(path, f"expected a number, got {_show(value)}")
     try:
         out = float(value)
     except OverflowError:
         out = math.inf
     if not math.isfinite(out):
-        raise DesignError(path, f"expected a finite number, got {_show(value)}")
+        raise ValueRuleError(path, f"expected a finite number, got {_show(value)}")
     return out
 
 
 def _to_int(path: str, rule: _Rule, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise DesignError(path, f"expected a whole number, got {_show(value)}")
+        raise ValueRuleError(path, f"expected a whole number, got {_show(value)}")
     return int(value)
 
 
 def _to_bool(path: str, rule: _Rule, value: Any) -> bool:
     if not isinstance(value, bool):
-        raise DesignError(path, f"expected true or false, got {_show(value)}")
+        raise ValueRuleError(path, f"expected true or false, got {_show(value)}")
     return value
 
 
 def _to_str(path: str, rule: _Rule, value: Any) -> str:
     if not isinstance(value, str):
-        raise DesignError(path, f"expected a string, got {_show(value)}")
+        raise ValueRuleError(path, f"expected a string, got {_show(value)}")
     return value
 
 
 def _to_strlist(path: str, rule: _Rule, value: Any) -> tuple[str, ...]:
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-        raise DesignError(path, f"expected a list of strings, got {_show(value)}")
+        raise ValueRuleError(path, f"expected a list of strings, got {_show(value)}")
     return tuple(v.lower() for v in value)
 
 
 def _to_floatlist(path: str, rule: _Rule, value: Any) -> tuple[float, ...]:
     if not isinstance(value, list):
-        raise DesignError(path, f"expected a list of numbers, got {_show(value)}")
+        raise ValueRuleError(path, f"expected a list of numbers, got {_show(value)}")
     return tuple(_to_float(f"{path}[{i}]", rule, v) for i, v in enumerate(value))
 
 
@@ -481,7 +601,7 @@ def _to_enum(path: str, rule: _Rule, value: Any) -> enum.Enum:
         word = value[:100] if isinstance(value, str) else ""
         close = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6)
         hint = f"; did you mean {close[0]!r}?" if close else ""
-        raise DesignError(path, f"{_show(value)} is not allowed{hint} (allowed: {', '.join(allowed)})")
+        raise ValueRuleError(path, f"{_show(value)} is not allowed{hint} (allowed: {', '.join(allowed)})")
     return rule.enum(value)
 
 
@@ -502,7 +622,7 @@ def _convert(path: str, rule: _Rule, value: Any) -> Any:
     if rule.check is not None:
         problem = rule.check(out)
         if problem:
-            raise DesignError(path, f"{_show(value)} {problem}")
+            raise ValueRuleError(path, f"{_show(value)} {problem}")
     if rule.kind == "floatlist":
         out = tuple(v * rule.scale for v in out)
     if rule.kind == "float":
@@ -528,10 +648,18 @@ def _section(name: str, table: Any) -> dict[str, Any]:
     return kwargs
 
 
-def _segment(index: int, table: Any, *, omega: float = 0.0, folder: Path | None = None) -> SegmentSpec:
+def _segment(
+    index: int,
+    table: Any,
+    *,
+    omega: float = 0.0,
+    folder: Path | None = None,
+    confine_to: Path | None = None,
+) -> SegmentSpec:
     """One ``[[motion]]`` table.
 
-    ``omega`` [rad/s] turns a ``velocity`` into a lift; ``folder`` is where a table's file is looked for.
+    ``omega`` [rad/s] turns a ``velocity`` into a lift; ``folder`` is where a table's file is looked for,
+    ``confine_to`` a folder it must stay inside (see :func:`read_table_file`).
     """
     path = f"motion[{index}]"
     if not isinstance(table, Mapping):
@@ -539,15 +667,17 @@ def _segment(index: int, table: Any, *, omega: float = 0.0, folder: Path | None 
     kind_value = table.get("kind")
     if kind_value is None:
         raise DesignError(f"{path}.kind", "is required (allowed: rise, return, dwell, table)")
-    kind = _convert(f"{path}.kind", _Rule("enum", enum=SegmentKind), kind_value)
+    kind = _convert(f"{path}.kind", _MOTION_RULES["kind"], kind_value)
+    if "law" in table:
+        _convert(f"{path}.law", _MOTION_RULES["law"], table["law"])
     if kind is SegmentKind.TABLE or table.get("law") == "table":
-        return _table_segment(path, kind, table, folder)
+        return _table_segment(path, kind, table, folder, confine_to)
     if "angle" not in table:
         raise DesignError(
             f"{path}.angle",
             f"is required (degrees of cam rotation, {MIN_SEGMENT_DEG:g} to {FULL_TURN_DEG:g})",
         )
-    span = _convert(f"{path}.angle", _Rule("float", check=_segment_angle), table["angle"])
+    span = _convert(f"{path}.angle", _MOTION_RULES["angle"], table["angle"])
     if kind is SegmentKind.DWELL:
         for key in table:
             if key not in ("kind", "angle"):
@@ -576,10 +706,14 @@ def _segment(index: int, table: Any, *, omega: float = 0.0, folder: Path | None 
             if key not in allowed_keys:
                 raise DesignError(f"{path}.{_key(key)}", _suggest(key, allowed_keys))
         law_params.pop("velocity", None)
-        for p in LAWS[law_name].parameters:
-            value = law_params.get(p.name)
-            if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2**53:
-                raise DesignError(f"{path}.{p.name}", f"{_show(value)} is out of range; allowed: {p.allowed}")
+        for name, rule in _LAW_RULES.get(law_name, {}).items():
+            if name in law_params:
+                try:
+                    _convert(f"{path}.{name}", rule, law_params[name])
+                except ValueRuleError as err:  # a wrong type: say what the law allows too
+                    if "allowed:" in err.message or rule.check is None:
+                        raise
+                    raise ValueRuleError(err.path, f"{err.message}; allowed: {rule.check.allowed}") from None
     try:
         law = make_law(law_name, **law_params)
     except DesignError as err:
@@ -601,9 +735,7 @@ def _segment_lift(path: str, kind: SegmentKind, table: Mapping[str, Any], span: 
             raise DesignError(f"{path}.velocity", "give lift or velocity, not both")
         if table.get("law") != "constant-velocity":
             raise DesignError(f"{path}.velocity", "applies to law = 'constant-velocity' only")
-        speed = _convert(
-            f"{path}.velocity", _Rule("float", check=_between(1e-6, 1e7, " per second")), table["velocity"]
-        )
+        speed = _convert(f"{path}.velocity", _MOTION_RULES["velocity"], table["velocity"])
         lift = speed / omega * span  # mm/s ÷ rad/s = mm/rad, × the span in rad
         if not MIN_LENGTH_MM <= lift <= MAX_LENGTH_MM:
             raise DesignError(
@@ -619,7 +751,7 @@ def _segment_lift(path: str, kind: SegmentKind, table: Mapping[str, Any], span: 
         )
     if table["lift"] == _CLOSE:
         return math.nan
-    return float(_convert(f"{path}.lift", _Rule("float", check=_length), table["lift"]))
+    return float(_convert(f"{path}.lift", _MOTION_RULES["lift"], table["lift"]))
 
 
 def _boundary(path: str, value: Any) -> Boundary:
@@ -638,12 +770,12 @@ def _boundary(path: str, value: Any) -> Boundary:
             continue
         if isinstance(item, str):
             raise DesignError(f"{path}.{key}", f'{_show(item)} is not allowed; give a number or "match"')
-        out[key] = _convert(f"{path}.{key}", _Rule("float", check=_between(-1e9, 1e9)), item)
+        out[key] = _convert(f"{path}.{key}", _BOUNDARY_RULE, item)
     return Boundary(**out)
 
 
 def _table_segment(
-    path: str, kind: SegmentKind, table: Mapping[str, Any], folder: Path | None
+    path: str, kind: SegmentKind, table: Mapping[str, Any], folder: Path | None, confine_to: Path | None
 ) -> SegmentSpec:
     """A point table over the whole turn: kind = "table", law = "table", file, noise."""
     if kind is not SegmentKind.TABLE:
@@ -654,24 +786,35 @@ def _table_segment(
     if table.get("law", "table") != "table":
         raise DesignError(f"{path}.law", f"{_show(table['law'])}: a kind = 'table' segment has law = 'table'")
     if "angle" in table:
-        angle = _convert(f"{path}.angle", _Rule("float"), table["angle"])
-        if angle != FULL_TURN_DEG:
-            raise DesignError(f"{path}.angle", f"{angle:g}: a point table covers the whole turn (360)")
+        _convert(f"{path}.angle", _TABLE_ANGLE_RULE, table["angle"])
     for key in ("file", "noise"):
         if key not in table:
             what = "the CSV of angle [°], lift[, velocity]"
             what = what if key == "file" else "the measurement noise σ (mm)"
             raise DesignError(f"{path}.{key}", f"is required for a point table ({what})")
-    name = _convert(f"{path}.file", _Rule("str"), table["file"])
-    noise = _convert(f"{path}.noise", _Rule("float", check=_between(1e-6, 10.0, " mm")), table["noise"])
-    file = (folder or Path.cwd()) / name
-    try:
-        text = file.read_text(encoding="utf-8-sig")
-    except (OSError, ValueError) as err:
-        why = getattr(err, "strerror", None) or err
-        raise DesignError(f"{path}.file", f"cannot read {file}: {why}") from None
+    name = _convert(f"{path}.file", _MOTION_RULES["file"], table["file"])
+    noise = _convert(f"{path}.noise", _MOTION_RULES["noise"], table["noise"])
+    text = read_table_file(name, folder=folder, where=f"{path}.file", confine_to=confine_to)
     angle_rad, lift, velocity = parse_table_text(text, where=f"{path}.file")
+    if angle_rad.size >= SCATTER_MIN_POINTS:  # FITPACK would chase the scatter with knots for minutes
+        scatter = table_scatter(angle_rad, lift)
+        if scatter > SCATTER_PER_NOISE * noise:
+            raise DesignError(
+                f"{path}.noise",
+                f"{noise:g} is far below the table's own scatter (about {scatter:.3g}, from its sixth "
+                f"differences): the smoothing could not come within the stated noise; allowed: noise ≥ "
+                f"{scatter / SCATTER_PER_NOISE:.3g} for this table (its measurement's σ or rounding)",
+            )
     law = smooth_table(angle_rad, lift, noise=noise, velocity=velocity, source=Path(name).name)
+    lowest, at = law.trough
+    if lowest < -FLAG_SIGMAS * noise:  # as a return below the base circle is refused (_check_program)
+        at_deg = math.degrees(at) if math.degrees(at) < FULL_TURN_DEG - 5e-4 else 0.0
+        raise DesignError(
+            f"{path}.file",
+            f"the smoothed lift dips to {lowest:.6g} at φ = {at_deg:.3f}°, below the base circle (lift 0) by "
+            f"more than the stated noise explains ({FLAG_SIGMAS:g} σ = {FLAG_SIGMAS * noise:g}); allowed: "
+            "lift ≥ 0 over the whole turn (measure from the base circle)",
+        )
     return SegmentSpec(kind=SegmentKind.TABLE, span=FULL_TURN_DEG * DEG, law=law)
 
 
@@ -847,6 +990,7 @@ def _check_style(design: Design) -> None:
     )
     if options.conjugate.single_plate:  # only a [conjugate] table sets it, and only a pair may have one
         _check_constant_breadth(design)
+    family.check_cam(lambda: Cam.from_design(design), options)  # a pair's rollers must clear each other
 
 
 def _check_constant_breadth(design: Design) -> None:
@@ -957,6 +1101,7 @@ def _check_fea(design: Design) -> None:
     """The FE check holds a plain plate at its bore, and its keyway fillet must fit."""
     if design.fea is None:
         return
+    from camcad.fea.mesh import MAX_ELEMENTS, estimated_triangles, smallest_mesh_size
     from camcad.fea.model import keyway_fillet
 
     if not family_of(design.cam.style).one_plate:
@@ -969,6 +1114,16 @@ def _check_fea(design: Design) -> None:
         )
     if bore.has_keyway:
         keyway_fillet(design.fea, bore)
+    size = design.fea.mesh_size
+    area = math.pi * (design.cam.base_radius**2 - bore.radius**2)  # at least the base circle's ring
+    if size is not None and estimated_triangles(area, size) > MAX_ELEMENTS:
+        raise DesignError(
+            "fea.mesh_size",
+            f"{size:g} mm would fill the plate (at least the {area:.0f} mm² of the base circle outside the "
+            f"bore) with {estimated_triangles(area, size):.3g} triangles or more; allowed: at most "
+            f"{MAX_ELEMENTS} (mesh_size ≥ {smallest_mesh_size(area):.3g} mm for this base circle, more "
+            "for the whole plate)",
+        )
 
 
 def _check_gcode(design: Design) -> None:
@@ -1073,8 +1228,13 @@ def _check_follower_keys(kind: FollowerKind, follower: Mapping[str, Any], dynami
             )
 
 
-def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
+def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path | None = None) -> Design:
     """Validate a design given as a TOML-like mapping.
+
+    A point table's ``file`` is read relative to the folder of ``source``
+    (the design file's path; the working folder when empty), and, when
+    ``confine_to`` is given, must resolve (symlinks followed) inside that
+    folder (see :func:`~camcad.design.table_file.read_table_file`).
 
     Raises
     ------
@@ -1111,15 +1271,18 @@ def parse_design(data: Mapping[str, Any], *, source: str = "") -> Design:
         )
     folder = Path(source).parent if source else None
     omega = specs["cam"].omega
-    motion = tuple(_segment(i, seg, omega=omega, folder=folder) for i, seg in enumerate(raw_motion))
+    motion = tuple(
+        _segment(i, seg, omega=omega, folder=folder, confine_to=confine_to)
+        for i, seg in enumerate(raw_motion)
+    )
     motion = _finish_motion(motion, unit="°" if follower.kind.oscillating else " mm")
     design = Design(motion=motion, source=source, **specs)
     _check_design(design)
     return design
 
 
-def load_design(path: str | Path) -> Design:
-    """Read and validate a TOML design file.
+def load_design(path: str | Path, *, confine_to: Path | None = None) -> Design:
+    """Read and validate a TOML design file (``confine_to``: see :func:`parse_design`).
 
     Raises
     ------
@@ -1145,7 +1308,7 @@ def load_design(path: str | Path) -> Design:
     except ValueError as err:  # Python's limit on the digits of one integer
         where = _find_value(text, lambda v: re.search(rf"\d{{{_MAX_DIGITS}}}", v) is not None)
         raise DesignError(where, f"a number too long to read: {err}".split("; use")[0]) from None
-    return parse_design(data, source=str(path))
+    return parse_design(data, source=str(path), confine_to=confine_to)
 
 
 MAX_NESTING = 100

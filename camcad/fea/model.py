@@ -50,7 +50,17 @@ from camcad.dynamics.contact import contact_curvature, effective_modulus, hertz_
 from camcad.dynamics.spec import DynamicsModel, DynamicsSetup
 from camcad.errors import DesignError
 from camcad.extremes import Extreme, Side
-from camcad.fea.mesh import Curve, Loop, Piece, PlateMesh, Spot, mesh_region
+from camcad.fea.mesh import (
+    MAX_ELEMENTS,
+    Curve,
+    Loop,
+    Piece,
+    PlateMesh,
+    Spot,
+    estimated_triangles,
+    mesh_region,
+    smallest_mesh_size,
+)
 from camcad.fea.results import FeaResult, LoadCase, Peak, StressCase, peak_of
 from camcad.fea.solve import ElasticPlate, Material, Support
 from camcad.fea.spec import PLANE_STRAIN_RATIO, FeaSpec, PlaneModel
@@ -311,6 +321,16 @@ def mesh_plate(cam: Cam, plate: Plate, cases: Sequence[LoadCase], spec: FeaSpec)
     fillet = keyway_fillet(spec, bore) if bore.has_keyway else 0.0
     outer_radius = float(np.max(np.hypot(*cam.profile(cam.sample_phi(math.radians(1.0))).point.T)))
     h_max = spec.mesh_size if spec.mesh_size is not None else outer_radius / 10.0
+    outline = cam.profile(cam.sample_phi(math.radians(1.0))).point
+    x, y = outline[:, 0], outline[:, 1]
+    area = 0.5 * abs(float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))) - math.pi * bore.radius**2
+    if estimated_triangles(area, h_max) > MAX_ELEMENTS:
+        raise DesignError(
+            "fea.mesh_size",
+            f"{h_max:g} mm would fill the plate's {area:.0f} mm² with about "
+            f"{estimated_triangles(area, h_max):.3g} triangles; allowed: at most {MAX_ELEMENTS} "
+            f"(mesh_size ≥ {smallest_mesh_size(area):.3g} mm for this plate)",
+        )
     fixed: list[float] = []
     spots = [Spot(centre=(0.0, 0.0), size=min(h_max, TWO_PI * bore.radius / 36.0), radius=bore.radius)]
     for c in cases:

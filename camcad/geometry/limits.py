@@ -15,10 +15,12 @@ from camcad.extremes import SIDE_WORDS, Extreme, Kind, Quantity, Side, extremes_
 from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
+from camcad.geometry.envelope import LineElement, PointElement
+from camcad.geometry.followers.tied import TiedRoller
 from camcad.geometry.sizing import min_base_radius
 from camcad.roots import brent_root
 
-__all__ = ["GeometryAnalysis", "Undercut", "analyse_geometry", "undercut_error"]
+__all__ = ["GeometryAnalysis", "Undercut", "analyse_geometry", "conjugate_overlap", "undercut_error"]
 
 _SUGGEST_ROUND_MM = 0.01
 
@@ -313,6 +315,7 @@ def analyse_geometry(
         undercut = Undercut(
             ranges=tuple(ranges), worst=worst.value, worst_angle=worst.phi, worst_side=worst.side
         )
+    findings += _pivot_clearance(cam, radius_max)
     findings += _velocity_jumps(cam)
     findings += _reversals(cam)
     s = np.asarray(motion.s)
@@ -348,6 +351,95 @@ def analyse_geometry(
         unit="mm",
     )
     return replace(analysis, findings=(undercut_finding, *analysis.findings))
+
+
+def _pivot_clearance(cam: Cam, radius_max: Extreme) -> list[Finding]:
+    """A hard finding when an arm's pivot lies inside the circle the profile sweeps (the cam would hit it).
+
+    The profile turns with the cam, so every point of it passes through the
+    circle of radius R_max = max |profile| about the cam axis; a pivot (and
+    the arm's hub on it) at a distance d ≤ R_max from the axis lies in that
+    swept disc. Allowed: d > R_max, a strict bound with no hub size added
+    (the design states none).
+    """
+    pivot = cam.kinematics.guide.pivot
+    if pivot is None:
+        return []
+    d = math.hypot(*pivot)
+    if d > radius_max.value:
+        return []
+    return [
+        Finding(
+            kind="pivot clearance",
+            severity=Severity.HARD,
+            field="follower.pivot_distance",
+            message=(
+                f"follower.pivot_distance: {d:g} mm puts the pivot inside the circle the profile sweeps "
+                f"(the profile reaches {radius_max.value:.3f} mm from the cam axis {radius_max.where()}): "
+                f"the cam would hit the arm's hub; allowed: pivot_distance > {radius_max.value:.3f} mm "
+                "(move the pivot out, or lower the lift or the base radius)"
+            ),
+            angle=radius_max.phi,
+            value=d,
+            limit=radius_max.value,
+            unit="mm",
+        )
+    ]
+
+
+def conjugate_overlap(partner: Cam) -> tuple[str, str] | None:
+    """Why a conjugate pair's two rollers overlap, as (field path, message); None when they clear.
+
+    ``partner`` is the pair's second plate (:meth:`Cam.partner`). The second
+    roller is tied rigidly to the first (:class:`TiedRoller`): on a slide its
+    centre is the first's shifted by a fixed Δ, on an arm it is the first's
+    turned by the included angle θ about the pivot, so the distance between
+    the centres is the same at every cam angle: |Δ| = √(a² + b² − 2ab cos θ)
+    (a = |M1| at the top of the lift, b = r_b + r_f2; law of cosines) or
+    2l·sin(θ/2) (the chord of the arm's circle of radius l). Seen along the
+    shaft, the rollers overlap when that distance is below r_f + r_f2.
+    """
+    tied = partner.kinematics
+    conj = partner.conjugate
+    if conj is None or not isinstance(tied, TiedRoller):
+        return None
+    first = tied.first
+    motion = partner.motion(0.0)
+    m1 = _centre(first.element(motion))
+    gap = float(np.hypot(*(tied.element(motion).m0[0] - m1)))
+    need = first.roller_radius + tied.roller_radius
+    if gap >= need:
+        return None
+    pivot = first.guide.pivot
+    if pivot is not None:
+        arm = float(np.hypot(*(m1 - np.asarray(pivot))))
+        cos_max = 1.0 - need**2 / (2.0 * arm**2)  # 2l sin(θ/2) ≥ need ⇔ cos θ ≤ 1 − need²/(2l²)
+        how = f"arms of length {arm:g} mm"
+    else:
+        breakpoints = partner.program.breakpoints
+        top_phi = max((bp.phi for bp in breakpoints), key=lambda p: float(partner.motion(p).s[0]))
+        a = float(np.hypot(*_centre(first.element(partner.motion(top_phi)))))
+        b = partner.base_radius + tied.roller_radius
+        cos_max = (a * a + b * b - need * need) / (2.0 * a * b)  # |Δ|² ≥ need² by the law of cosines
+        how = f"centres {a:.4g} mm and {b:g} mm from the cam axis at the top of the lift"
+    if cos_max <= -1.0:
+        allowed = "no angle: use smaller rollers"
+    else:
+        lo = math.degrees(math.acos(min(1.0, cos_max)))
+        allowed = f"{lo:.3f}° to {360.0 - lo:.3f}°"
+    return (
+        "conjugate.angle",
+        f"{math.degrees(conj.angle):g}° puts the two rollers' centres {gap:.4g} mm apart at every cam "
+        f"angle, less than the sum of their radii {need:g} mm: the rollers overlap ({how}); "
+        f"allowed: {allowed}",
+    )
+
+
+def _centre(element: PointElement | LineElement) -> FloatArray:
+    """A roller's centre [mm] (a conjugate pair drives rollers: the element is a point path)."""
+    assert isinstance(element, PointElement), "a conjugate pair needs roller followers"
+    out: FloatArray = element.m0[0]
+    return out
 
 
 def _up(value: float) -> float:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import subprocess
 import sys
@@ -181,3 +182,35 @@ def test_fea_needs_a_bore():
     with pytest.raises(DesignError) as err:
         parse_design(data)
     assert err.value.path == "cam.bore"
+
+
+def test_a_mesh_too_fine_is_refused_before_meshing_naming_the_smallest_size():
+    """Issue 32: mesh_size = 0.001 ran for minutes; now an exit 2 at once, naming the size allowed.
+
+    Independent: the ring of the base circle outside the bore, π(r_b² − r_bore²), filled with
+    equilateral triangles of area (√3/4)·h², and the bound of 30 000 triangles.
+    """
+    import time
+
+    from camcad.fea.mesh import MAX_ELEMENTS
+
+    area = math.pi * (40.0**2 - 8.0**2)
+    smallest = math.sqrt(area / (math.sqrt(3.0) / 4.0 * MAX_ELEMENTS))
+    start = time.perf_counter()
+    with pytest.raises(DesignError) as err:
+        _design("[fea]\nmesh_size = 0.001\n")
+    assert time.perf_counter() - start < 5.0
+    assert err.value.path == "fea.mesh_size"
+    assert f"mesh_size ≥ {smallest:.3g} mm" in err.value.message
+    _design(f"[fea]\nmesh_size = {smallest * 1.0001}\n")  # just above: accepted by the loader
+    with pytest.raises(DesignError):
+        _design(f"[fea]\nmesh_size = {smallest * 0.9999}\n")
+
+
+def test_the_whole_plate_bounds_the_mesh_before_gmsh_runs(tmp_path: Path, capsys: pytest.CaptureFixture[str]):
+    """Past the loader's base-circle bound, mesh_plate bounds the element count on the plate's area."""
+    design = _write(tmp_path, DESIGN + "\n[fea]\nmesh_size = 0.65\n")
+    assert main(["build", str(design), "-o", str(tmp_path / "out"), "-q", "--only", "fea"]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith("camcad: error: fea.mesh_size: 0.65 mm") and "for this plate" in line
+    assert not (tmp_path / "out").exists()

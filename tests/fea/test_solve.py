@@ -155,3 +155,13 @@ def test_boundary_nodes_are_exact_and_sizes_follow_the_spots():
     material = Material(modulus=E, poisson=NU, plane=PlaneModel.STRESS)
     plate = ElasticPlate(mesh, material)
     assert plate.area() == pytest.approx(math.pi * (B_OUT**2 - A_IN**2), rel=2e-5)
+
+
+@pytest.mark.parametrize("h", [4.0, 2.0, 1.0])
+def test_the_element_estimate_is_within_a_fifth_of_gmsh_on_a_ring(h):
+    """estimated_triangles (area / (√3/4 h²)) against the count gmsh makes on the ring, no refinement."""
+    from camcad.fea.mesh import estimated_triangles
+
+    made = len(_ring(h).triangles)
+    estimate = estimated_triangles(math.pi * (B_OUT**2 - A_IN**2), h)
+    assert 0.8 * made <= estimate <= 1.2 * made, (made, estimate)

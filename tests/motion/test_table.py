@@ -7,6 +7,11 @@ from, and noise of a known σ drawn with fixed seeds.
 from __future__ import annotations
 
 import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -128,7 +133,7 @@ def test_parse_header_comments_separators_and_closing_row():
     ("text", "words"),
     [
         ("0,1\n10,2\n5,3\n" + "".join(f"{20 + i},0\n" for i in range(12)), "angles must increase"),
-        ("0,1\n1,x\n", "not numbers"),
+        ("0,1\n1,x\n", "line 2, field 2: expected a number"),
         ("0,1\n1,2\n", "at least 12"),
         ("".join(f"{i * 30},{i}\n" for i in range(12)) + "360,5\n", "must repeat the row at 0°"),
         ("".join(f"{i * 30},{i},{i}\n" for i in range(11)) + "350,1\n", "different numbers of columns"),
@@ -180,3 +185,193 @@ def test_design_reads_the_table_relative_to_the_design_file(tmp_path):
             source=str(tmp_path / "cam.toml"),
         )
     assert err.value.path == "motion[0].kind"
+
+
+# ---------------------------------------------------------------------------
+# issue 32: what a table file may be, and what an error may show of it
+
+
+def _table_design(file: str) -> dict:
+    return {
+        "cam": {"base_radius": 50, "thickness": 10},
+        "follower": {"roller_radius": 10},
+        "motion": [{"kind": "table", "file": file, "noise": SIGMA}],
+    }
+
+
+def _good_rows(lift=lambda a: 5 * (1 - math.cos(math.radians(a)))) -> str:
+    return "angle_deg,lift_mm\n" + "".join(f"{a},{lift(a):.6f}\n" for a in range(0, 360, 10))
+
+
+def _refusal(data: dict, source: Path, **kw) -> DesignError:
+    with pytest.raises(DesignError) as err:
+        parse_design(data, source=str(source), **kw)
+    return err.value
+
+
+@pytest.mark.parametrize(
+    ("file", "words"),
+    [
+        ("/dev/zero", "not a regular file"),
+        ("/dev/urandom", "not a regular file"),
+        ("/dev/null", "not a regular file"),
+        (".", "it is a folder"),
+    ],
+    ids=["dev-zero", "dev-urandom", "dev-null", "folder"],
+)
+def test_only_a_regular_file_is_read(tmp_path, file, words):
+    if not Path(file if file != "." else tmp_path).exists():
+        pytest.skip(f"{file} is not on this system")
+    err = _refusal(_table_design(file), tmp_path / "cam.toml")
+    assert err.path == "motion[0].file" and words in err.message
+
+
+def test_a_fifo_is_refused_without_blocking(tmp_path):
+    """In a child process with a deadline: a blocking open would hang it, not the test run."""
+    if not hasattr(os, "mkfifo"):
+        pytest.skip("no FIFOs on this system")
+    os.mkfifo(tmp_path / "lift.csv")
+    design = tmp_path / "cam.toml"
+    design.write_text(
+        '[cam]\nbase_radius = 50\n[follower]\nroller_radius = 10\n[[motion]]\nkind = "table"\n'
+        'file = "lift.csv"\nnoise = 0.005\n'
+    )
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2]))
+    proc = subprocess.run(
+        [sys.executable, "-m", "camcad", "check", str(design)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
+    assert proc.returncode == 2
+    fifo = repr(str(tmp_path / "lift.csv"))
+    assert proc.stderr.splitlines() == [
+        f"camcad: error: motion[0].file: cannot read {fifo}: it is not a regular file "
+        "(a device, pipe or socket); allowed: a regular file"
+    ]
+
+
+def test_a_file_over_16_mib_is_refused_unread(tmp_path):
+    from camcad.design.table_file import MAX_TABLE_BYTES
+
+    with (tmp_path / "big.csv").open("wb") as f:  # sparse: no disk, and never read
+        f.truncate(MAX_TABLE_BYTES + 1)
+    err = _refusal(_table_design("big.csv"), tmp_path / "cam.toml")
+    assert err.path == "motion[0].file" and f"at most {MAX_TABLE_BYTES} bytes (16 MiB)" in err.message
+    (tmp_path / "ok.csv").write_text(_good_rows() + "#" * (MAX_TABLE_BYTES - 2000) + "\n")
+    parse_design(_table_design("ok.csv"), source=str(tmp_path / "cam.toml"))  # just under: read
+
+
+SECRET = "hunter2-sk-0123456789"
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        f"root:x:0:0:{SECRET}\ndaemon:{SECRET}\n",  # /etc/passwd-like: the header, then a line of text
+        f"angle,lift\n0,0\n10,{SECRET}\n",
+        f"angle,lift\n0,0\n10 {SECRET} 1\n",
+        f"0,0\n{SECRET}\n",
+    ],
+    ids=["passwd", "cell", "middle-cell", "whole-line"],
+)
+def test_errors_name_the_line_and_field_never_the_text(tmp_path, text):
+    (tmp_path / "t.csv").write_text(text)
+    err = _refusal(_table_design("t.csv"), tmp_path / "cam.toml")
+    assert err.path == "motion[0].file" and "expected a number" in err.message
+    assert SECRET not in str(err) and "hunter" not in str(err) and "root" not in str(err)
+    assert re.search(r"line \d+, field \d+", err.message)
+
+
+def test_a_file_that_is_not_utf8_is_refused_without_its_bytes(tmp_path):
+    (tmp_path / "t.csv").write_bytes(b"0,0\n1,\xff\xfe" + SECRET.encode())
+    err = _refusal(_table_design("t.csv"), tmp_path / "cam.toml")
+    assert (
+        "not UTF-8 text (byte offset 6)" in err.message and SECRET not in str(err) and "0xff" not in str(err)
+    )
+
+
+def test_confine_to_keeps_the_file_inside_the_folder(tmp_path):
+    inside, outside = tmp_path / "designs", tmp_path / "secret"
+    inside.mkdir()
+    outside.mkdir()
+    (inside / "lift.csv").write_text(_good_rows())
+    (outside / "lift.csv").write_text(_good_rows())
+    (inside / "link.csv").symlink_to(outside / "lift.csv")
+    source = inside / "cam.toml"
+    parse_design(_table_design("lift.csv"), source=str(source), confine_to=inside)
+    for name in ("../secret/lift.csv", str(outside / "lift.csv"), "link.csv"):
+        err = _refusal(_table_design(name), source, confine_to=inside)
+        assert err.path == "motion[0].file" and "leads outside the design's folder" in err.message, name
+        parse_design(_table_design(name), source=str(source))  # without confinement each is read
+    assert not (inside / "nope.csv").exists()
+    err = _refusal(_table_design("nope.csv"), source, confine_to=inside)
+    assert "No such file" in err.message
+
+
+@pytest.mark.parametrize(
+    ("cell", "field"),
+    [("1e300", 2), ("nan", 2), ("inf", 2), ("-1e5", 2), ("1e300", 3)],
+    ids=["lift-1e300", "lift-nan", "lift-inf", "lift-negative-huge", "velocity-1e300"],
+)
+def test_table_values_are_bounded_like_every_length(cell, field):
+    """1e300 made FITPACK fail with a SciPy internal error; now the line and field are named."""
+    rows = [f"{a},{a / 100:.4f},0.0" for a in range(0, 360, 10)]
+    a, s, v = rows[5].split(",")
+    rows[5] = ",".join([a, cell, v] if field == 2 else [a, s, cell])
+    with pytest.raises(DesignError) as err:
+        parse_table_text("\n".join(rows), where="motion[0].file")
+    assert err.value.message.startswith(f"line 6, field {field} (")
+    assert "at most 10000" in err.value.message
+
+
+@pytest.mark.parametrize("angle", ["-0.5", "360.5", "1e300"], ids=["negative", "past-360", "huge"])
+def test_table_angles_outside_the_turn_name_the_line(angle):
+    rows = [f"{a},0" for a in range(0, 360, 10)]
+    rows.insert(3, f"{angle},0") if angle != "-0.5" else rows.insert(0, f"{angle},0")
+    with pytest.raises(DesignError) as err:
+        parse_table_text("\n".join(rows), where="motion[0].file")
+    assert re.match(r"line \d+, field 1 \(angle", err.value.message), err.value.message
+
+
+def test_the_trough_is_the_smallest_lift_by_brute_force():
+    phi, lift = noisy_table(3)
+    law = smooth_table(phi, lift - 0.2, noise=SIGMA)
+    lowest, at = law.trough
+    dense = np.linspace(0.0, 2 * math.pi, 400_001)
+    s = law.evaluate(dense / (2 * math.pi))[0]
+    assert lowest <= float(s.min()) + 1e-12 and lowest == pytest.approx(float(s.min()), abs=1e-9)
+    assert float(law.evaluate(at / (2 * math.pi))[0]) == pytest.approx(lowest, abs=1e-12)
+
+
+def test_a_table_below_the_base_circle_is_refused(tmp_path):
+    """As a return below the base circle is (segments): after smoothing, past what the noise explains (4σ)."""
+    (tmp_path / "low.csv").write_text(_good_rows(lambda a: 5 * (1 - math.cos(math.radians(a))) - 0.5))
+    err = _refusal(_table_design("low.csv"), tmp_path / "cam.toml")
+    assert err.path == "motion[0].file" and "below the base circle" in err.message
+    assert "dips to -0.5" in err.message and "φ = 0.000°" in err.message
+    (tmp_path / "noisy.csv").write_text(_good_rows(lambda a: 5 * (1 - math.cos(math.radians(a))) - 2 * SIGMA))
+    parse_design(_table_design("noisy.csv"), source=str(tmp_path / "cam.toml"))  # within the noise: kept
+
+
+def test_a_long_table_with_a_noise_below_its_scatter_is_refused_at_once(tmp_path):
+    """A 36 000-row table rounded to 0.1 µm with noise 1e-6 ran for more than 10 minutes (issue 32).
+
+    Independent: rounding to q scatters within ±q/2 (σ = q/√12 if uniform and independent; on a
+    slowly varying law the rounding errors are correlated, so the estimate lies between that and q/2).
+    """
+    from camcad.motion.table import table_scatter
+
+    phi = np.arange(36000) * 0.01
+    lift = np.round(5 * (1 - np.cos(np.radians(phi))), 4)
+    assert 1e-4 / math.sqrt(12) <= table_scatter(np.radians(phi), lift) <= 1e-4 / 2
+    rows = "".join(f"{a:.2f},{s:.4f}\n" for a, s in zip(phi, lift, strict=True))
+    (tmp_path / "lift.csv").write_text("angle,lift\n" + rows)
+    data = _table_design("lift.csv")
+    data["motion"][0]["noise"] = 1e-6
+    err = _refusal(data, tmp_path / "cam.toml")
+    assert err.path == "motion[0].noise" and "far below the table's own scatter" in err.message
+    noisy, _ = noisy_table(5, step_deg=0.25)  # 1440 rows of noise σ: the estimate finds σ
+    _, lift_noisy = noisy_table(5, step_deg=0.25)
+    assert table_scatter(noisy, lift_noisy) == pytest.approx(SIGMA, rel=0.15)

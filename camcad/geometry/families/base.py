@@ -18,7 +18,7 @@ adds its own shape (walls on a cylinder) here and its writers below.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol, TypedDict
 
@@ -206,6 +206,13 @@ class CamFamily(Protocol):
         """Raise :class:`~camcad.errors.DesignError` (naming its field) where the design cannot be made.
 
         ``base_radius``, ``roller_radius`` (the designed follower's) and ``thickness`` in mm.
+        """
+        ...
+
+    def check_cam(self, cam: Callable[[], Cam], options: FamilyOptions) -> None:
+        """Raise :class:`~camcad.errors.DesignError` where the designed cam cannot make the family's parts.
+
+        ``cam`` builds the designed cam (called only by a family that needs it).
         """
         ...
 

@@ -10,11 +10,13 @@ rollers on one plate: the second part is analysed, not made.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
+from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
 from camcad.geometry.families.base import Drive, FamilyOptions, Part, PartResults
+from camcad.geometry.limits import conjugate_overlap
 
 __all__ = ["CONJUGATE", "ConjugateFamily"]
 
@@ -47,6 +49,12 @@ class ConjugateFamily:
     def drive(self, roller_radius: float, options: FamilyOptions) -> Drive:
         """The two plates drive the follower both ways, each through its own roller."""
         return Drive(positive_drive=True, clearance=0.0, flank_offsets=None)
+
+    def check_cam(self, cam: Callable[[], Cam], options: FamilyOptions) -> None:
+        """The two rollers must clear each other, seen along the shaft (:func:`conjugate_overlap`)."""
+        problem = conjugate_overlap(cam().partner(options.conjugate))
+        if problem is not None:
+            raise DesignError(*problem)
 
     def summary(self, results: Sequence[PartResults]) -> dict[str, Any]:
         """The ``second_plate`` section: its geometry, its dynamics and its fit."""

@@ -8,7 +8,7 @@ blank's rim, the bore and the largest cutter.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -73,6 +73,9 @@ class GrooveFamily:
         clearance = options.groove.clearance
         offsets = roller_flank_offsets(roller_radius, clearance)
         return Drive(positive_drive=True, clearance=clearance, flank_offsets=offsets)
+
+    def check_cam(self, cam: Callable[[], Cam], options: FamilyOptions) -> None:
+        """Nothing to check on the cam itself."""
 
     def summary(self, results: Sequence[PartResults]) -> dict[str, Any]:
         """The ``groove`` section: flank checks, flank fits, the flank at the largest pressure angle."""

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from camcad.errors import DesignError
@@ -34,6 +34,9 @@ class PlateFamily:
     def drive(self, roller_radius: float, options: FamilyOptions) -> Drive:
         """A spring holds the follower on the plate."""
         return Drive(positive_drive=False, clearance=0.0, flank_offsets=None)
+
+    def check_cam(self, cam: Callable[[], Cam], options: FamilyOptions) -> None:
+        """Nothing to check on the cam itself."""
 
     def summary(self, results: Sequence[PartResults]) -> dict[str, Any]:
         """Nothing beyond the common sections."""

@@ -1,0 +1,308 @@
+"""4-axis passes for a barrel cam's groove: rough with a small cutter, finish each wall with the roller's.
+
+Machine convention
+------------------
+The barrel lies on the rotary axis A, which turns about the machine's X;
+the barrel's axis z is machine X (z = 0 at X0); the tool points down the
+machine's −Z onto the barrel, its axis on the line Y = const, Z is the
+distance of the tool's tip from the barrel's axis. The barrel frame maps
+to the machine at A = 0 by x → Z, y → −Y, z → X (a proper rotation), and a
+positive A turns the barrel right-handed about +X, so the tool (at +Z) sees
+barrel angle θ = −A. The roller's axis at motion angle φ,
+t·e_r(φ) + y·e_θ(φ) + z·ẑ (:mod:`camcad.geometry.barrel`), is then the tool's
+axis at A = −φ [deg], Y = −y, X = z: the tool moves along the roller's own
+path, and a flat end mill of the roller's diameter cuts exactly the
+roller's envelope, i.e. the walls of a cylindrical roller, at every station.
+
+Between two blocks X, Y and A move linearly together, so in the developed
+plane of every station t (u = tφ + y, w = z) the tool's axis moves on a
+straight line between the exact points; its distance from the exact path is
+|(Δy, Δz)|, the same at every station, and the wall a disc of fixed radius
+sweeps moves by no more than its centre does. Blocks are split until that
+distance, checked at every eighth of a block and scaled by 64/63 (the
+peak of a parabola lies within 1/16 of a node), is within ``tolerance``,
+by bisection.
+
+Passes
+------
+- Finish, one per wall: the cutter of the roller's diameter on the roller's
+  path shifted by ±c/2 along the developed pitch line's normal at the pitch
+  station (c the clearance), tip at the groove's bottom radius.
+- Rough: a smaller cutter on the pitch path shifted by δ along the same
+  normal, |δ| ≤ r_w − r_c − stock (r_w = r_f + c/2), in steps no wider than
+  ``stepover`` × its diameter, at depth levels ``step_down`` apart down to the
+  bottom plus ``stock``. The shift δ moves the cutter's axis by |δ| at every
+  station, so the cutter stays at least ``stock`` inside each wall.
+
+A cutter smaller than the roller cannot finish a wall exactly: on the path
+offset by r_w − r_c along the pitch station's normal it cuts the wall at
+the pitch station only; :func:`small_cutter_deviation` measures the error at
+the groove's top and bottom.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from camcad._typing import FloatArray, readonly
+from camcad.errors import DesignError
+from camcad.geometry.barrel import BarrelFollower, BarrelOptions, RollerShape
+from camcad.geometry.barrel_limits import developed_walls
+from camcad.motion.program import MotionProgram
+
+__all__ = [
+    "BarrelPass",
+    "BarrelToolpath",
+    "BarrelToolpathOptions",
+    "plan_barrel",
+    "small_cutter_deviation",
+]
+
+_MAX_SPLITS = 30
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BarrelToolpathOptions:
+    """The 4-axis program's tools and passes [mm, mm/min].
+
+    ``tolerance``: the tool axis's largest distance from the exact path;
+    ``rough_diameter``: the roughing cutter (smaller than the roller);
+    ``stepover``: roughing passes' spacing as a fraction of its diameter;
+    ``step_down``: roughing depth per level; ``stock``: what roughing leaves
+    on the walls and the bottom; ``clearance_height``: above the barrel's
+    surface for rapids; feeds and tool numbers.
+    """
+
+    tolerance: float = 0.005
+    rough_diameter: float = 10.0
+    stepover: float = 0.4
+    step_down: float = 4.0
+    stock: float = 0.2
+    clearance_height: float = 5.0
+    feed: float = 300.0
+    plunge_feed: float = 60.0
+    spindle_rpm: float = 6000.0
+    rough_tool: int = 1
+    finish_tool: int = 2
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BarrelPass:
+    """One revolution of the tool: ``x``, ``y`` [mm], ``a`` [deg] (n,), tip at ``z`` [mm].
+
+    ``kind``: "rough", "finish upper" or "finish lower"; ``shift`` [mm]: the path's
+    offset from the pitch path along the pitch station's developed normal
+    (towards the upper wall); ``tool`` its number,
+    ``radius`` its cutter radius [mm]; ``deviation``: the axis's largest
+    distance from the exact path between blocks [mm].
+    """
+
+    kind: str
+    shift: float
+    tool: int
+    radius: float
+    z: float
+    x: FloatArray
+    y: FloatArray
+    a: FloatArray
+    deviation: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BarrelToolpath:
+    """Every pass in cutting order, with the options and the barrel they were planned for.
+
+    ``small_cutter`` (2, 2, 2) [mm]: what finishing the walls with the roughing
+    cutter instead would leave (:func:`small_cutter_deviation`) at the
+    groove's bottom and top (rows), upper and lower wall, (least, greatest).
+    """
+
+    passes: tuple[BarrelPass, ...]
+    options: BarrelToolpathOptions
+    barrel: BarrelOptions
+    small_cutter: FloatArray
+
+    @property
+    def max_deviation(self) -> float:
+        """The largest path deviation of any pass [mm]."""
+        return max(p.deviation for p in self.passes)
+
+
+def _path(
+    program: MotionProgram, follower: BarrelFollower, options: BarrelOptions, phi: FloatArray, shift: float
+) -> tuple[FloatArray, FloatArray]:
+    """(y, z) (n,) [mm] of the pitch path shifted by ``shift`` along the pitch station's developed normal."""
+    axis = follower.centre(program.evaluate(phi))
+    tp = options.pitch_station
+    du, dz = tp + axis.m1[:, 0], axis.m1[:, 1]
+    big = np.hypot(du, dz)
+    return axis.m0[:, 0] - shift * dz / big, axis.m0[:, 1] + shift * du / big
+
+
+def _refined(
+    program: MotionProgram, follower: BarrelFollower, options: BarrelOptions, shift: float, tolerance: float
+) -> tuple[FloatArray, float]:
+    """Angles φ (n + 1,) over 0 … 2π whose chords keep within ``tolerance`` of the path; the largest gap."""
+    phi = np.union1d(program.sample_phi(math.radians(2.0)), [math.tau])
+    for _ in range(_MAX_SPLITS):
+        fractions = np.arange(1, 8) / 8.0
+        mid = phi[:-1, None] + fractions[None, :] * np.diff(phi)[:, None]
+        y0, z0 = _path(program, follower, options, phi, shift)
+        ym, zm = _path(program, follower, options, mid.ravel(), shift)
+        ylin = y0[:-1, None] + fractions * np.diff(y0)[:, None]
+        zlin = z0[:-1, None] + fractions * np.diff(z0)[:, None]
+        # a block's gap is nearly a parabola in the fraction; its peak is within 1/16 of a node,
+        # where the parabola is at least 1 − 4/16² of it: the bound is the largest node / (1 − 1/64)
+        gap = np.hypot(ym.reshape(mid.shape) - ylin, zm.reshape(mid.shape) - zlin).max(axis=1) / (
+            1.0 - 1.0 / 64.0
+        )
+        bad = gap > tolerance
+        if not bad.any():
+            return phi, float(gap.max())
+        phi = np.union1d(phi, mid[bad, 3])
+    raise DesignError("gcode.tolerance", f"{tolerance:g} mm cannot be met by splitting blocks; loosen it")
+
+
+def _pass(
+    program: MotionProgram,
+    follower: BarrelFollower,
+    options: BarrelOptions,
+    *,
+    kind: str,
+    tool: int,
+    radius: float,
+    z: float,
+    shift: float,
+    tolerance: float,
+) -> BarrelPass:
+    phi, gap = _refined(program, follower, options, shift, tolerance)
+    y, zz = _path(program, follower, options, phi, shift)
+    x, yy, a = zz.copy(), -y, -np.degrees(phi)
+    readonly(x, yy, a)
+    return BarrelPass(kind=kind, shift=shift, tool=tool, radius=radius, z=z, x=x, y=yy, a=a, deviation=gap)
+
+
+def plan_barrel(
+    program: MotionProgram, follower: BarrelFollower, options: BarrelOptions, spec: BarrelToolpathOptions
+) -> BarrelToolpath:
+    """Rough and finish passes for the groove (module notes).
+
+    Raises
+    ------
+    DesignError
+        ``gcode.rough_diameter`` not smaller than the groove is wide less
+        twice the stock; ``gcode.step_down``, ``gcode.stepover``,
+        ``gcode.stock``, ``gcode.tolerance`` not positive; ``follower.roller``
+        conical (a cylindrical cutter cuts a conical roller's walls exactly at
+        one station only).
+    """
+    for path, value in (
+        ("gcode.tolerance", spec.tolerance),
+        ("gcode.step_down", spec.step_down),
+        ("gcode.stepover", spec.stepover),
+        ("gcode.rough_diameter", spec.rough_diameter),
+    ):
+        if not (math.isfinite(value) and value > 0.0):
+            raise DesignError(path, f"{value!r} is not allowed; give a number > 0")
+    if options.roller is RollerShape.CONICAL:
+        raise DesignError(
+            "follower.roller",
+            '"conical": its walls need a tapered cutter, which camcad does not plan yet; '
+            'the 4-axis program is for "cylindrical" rollers',
+        )
+    if not (math.isfinite(spec.stock) and spec.stock >= 0.0):
+        raise DesignError("gcode.stock", f"{spec.stock!r} mm is not allowed; give 0 mm or more")
+    r_w = options.roller_radius + 0.5 * options.clearance
+    r_c = 0.5 * spec.rough_diameter
+    reach = r_w - r_c - spec.stock
+    if reach < 0.0:
+        raise DesignError(
+            "gcode.rough_diameter",
+            f"{spec.rough_diameter:g} mm does not fit the groove {2 * r_w:g} mm wide with {spec.stock:g} mm "
+            f"stock on each wall; give rough_diameter ≤ {2 * (r_w - spec.stock):g} mm",
+        )
+    count = max(1, math.ceil(2.0 * reach / (spec.stepover * spec.rough_diameter)) + 1) if reach > 0 else 1
+    shifts = np.linspace(-reach, reach, count) if count > 1 else np.zeros(1)
+    bottom = options.bottom_radius + spec.stock
+    levels = np.arange(options.barrel_radius - spec.step_down, bottom, -spec.step_down)
+    levels = np.r_[levels[levels > bottom], bottom]
+    passes = [
+        _pass(
+            program,
+            follower,
+            options,
+            kind="rough",
+            tool=spec.rough_tool,
+            radius=r_c,
+            z=float(level),
+            shift=float(shift),
+            tolerance=spec.tolerance,
+        )
+        for level in levels
+        for shift in shifts
+    ]
+    half_c = 0.5 * options.clearance
+    passes += [
+        _pass(
+            program,
+            follower,
+            options,
+            kind=f"finish {name}",
+            tool=spec.finish_tool,
+            radius=options.roller_radius,
+            z=options.bottom_radius,
+            shift=sign * half_c,
+            tolerance=spec.tolerance,
+        )
+        for name, sign in (("upper", 1.0), ("lower", -1.0))
+    ]
+    small = small_cutter_deviation(
+        program, follower, options, r_c, np.array([options.bottom_radius, options.barrel_radius])
+    )
+    return BarrelToolpath(passes=tuple(passes), options=spec, barrel=options, small_cutter=small)
+
+
+def small_cutter_deviation(
+    program: MotionProgram,
+    follower: BarrelFollower,
+    options: BarrelOptions,
+    cutter_radius: float,
+    stations: FloatArray,
+    *,
+    step: float = math.radians(0.05),
+) -> FloatArray:
+    """How far a wall cut by a smaller cutter lies from the exact wall, at stations t [mm].
+
+    The cutter (radius r_c < r_w) follows the pitch path shifted by
+    ±(r_w − r_c) along the developed normal at the pitch station, so it is
+    exact there. At station t the cut wall is the boundary of the discs of
+    radius r_c round its axis in the developed plane; for each exact wall
+    point the distance to the nearest axis point minus r_c is the stock left
+    (> 0) or the gouge (< 0).
+
+    Returns
+    -------
+    FloatArray
+        (m, 2, 2) [mm]: per station, (upper, lower) wall × (least, greatest)
+        signed deviation.
+    """
+    r_w = options.roller_radius + 0.5 * options.clearance
+    phi = program.sample_phi(step)
+    motion = program.evaluate(phi)
+    out = np.zeros((len(stations), 2, 2))
+    for i, t in enumerate(np.asarray(stations, dtype=float)):
+        walls = developed_walls(motion, follower, options, float(t))
+        for j, (sign, wall) in enumerate(((1.0, walls.upper.point), (-1.0, walls.lower.point))):
+            y, z = _path(program, follower, options, phi, sign * (r_w - cutter_radius))
+            centres = np.column_stack((t * phi + y, z))
+            period = np.array([t * math.tau, 0.0])
+            tree = cKDTree(np.vstack((centres - period, centres, centres + period)))
+            dist, _ = tree.query(wall)
+            dev = dist - cutter_radius
+            out[i, j] = (float(dev.min()), float(dev.max()))
+    readonly(out)
+    return out

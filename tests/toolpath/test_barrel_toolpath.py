@@ -1,0 +1,100 @@
+"""The barrel's 4-axis passes (issue 36) against independent truths.
+
+- the chord deviation of every pass, recomputed on a 20× finer grid of the exact path;
+- a cutter smaller than the roller, offset to be exact at the pitch station, leaves stock
+  (never gouges) at the groove's bottom and top; for a translating roller the amount matches
+  the first-order estimate δ(1 − cos(β_t − β_p)), tan β_t = s′/t, δ = r_w − r_c (the cutter's
+  axis shifted by δ along the pitch station's normal is δ·cos Δβ off the line at station t);
+- bad options name their field.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from camcad.errors import DesignError
+from camcad.toolpath.barrel import BarrelToolpathOptions, plan_barrel, small_cutter_deviation
+from tests.barrel_cases import CASES, INDEXER
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_blocks_keep_the_axis_within_tolerance(name):
+    c = CASES[name]
+    spec = BarrelToolpathOptions(tolerance=0.01)
+    tp = plan_barrel(c.program, c.follower, c.options, spec)
+    assert tp.max_deviation <= spec.tolerance
+    tp_station = c.options.pitch_station
+    for p in tp.passes:
+        phi = -np.radians(p.a)
+        f = np.linspace(0.0, 1.0, 41)[1:-1]
+        fine = (phi[:-1, None] + f * np.diff(phi)[:, None]).ravel()
+        y_lin = -(p.y[:-1, None] + f * np.diff(p.y)[:, None]).ravel()
+        z_lin = (p.x[:-1, None] + f * np.diff(p.x)[:, None]).ravel()
+        # the exact path, rebuilt here: the follower's axis shifted along the developed pitch normal
+        axis = c.follower.centre(c.program.evaluate(fine))
+        du, dz = tp_station + axis.m1[:, 0], axis.m1[:, 1]
+        norm = np.hypot(du, dz)
+        y = axis.m0[:, 0] - p.shift * dz / norm
+        z = axis.m0[:, 1] + p.shift * du / norm
+        assert np.max(np.hypot(y - y_lin, z - z_lin)) <= spec.tolerance
+        assert abs(p.shift) + p.radius <= c.options.roller_radius + 0.5 * c.options.clearance + 1e-12
+
+
+def test_the_program_reports_the_small_cutters_deviation():
+    from camcad.export.gcode.barrel import render_barrel_program
+
+    c = INDEXER
+    tp = plan_barrel(c.program, c.follower, c.options, BarrelToolpathOptions())
+    again = small_cutter_deviation(
+        c.program, c.follower, c.options, 5.0, np.array([c.options.bottom_radius, c.options.barrel_radius])
+    )
+    assert np.array_equal(tp.small_cutter, again)
+    text = render_barrel_program(tp)
+    assert f"{np.abs(again[0]).max():.4f} at the groove's bottom" in text
+
+
+def test_a_smaller_cutter_leaves_stock_at_bottom_and_top_as_estimated():
+    c = INDEXER
+    o = c.options
+    r_c = 5.0
+    stations = np.array([o.bottom_radius, o.pitch_station, o.barrel_radius])
+    dev = small_cutter_deviation(c.program, c.follower, o, r_c, stations)
+    assert np.all(dev[..., 0] >= -1e-4)  # no gouge anywhere
+    assert np.all(np.abs(dev[1]) <= 1e-3)  # exact at the pitch station
+    phi = np.linspace(0.0, 2.0 * math.pi, 20001)
+    v = c.program.evaluate(phi).v
+    delta = o.roller_radius + 0.5 * o.clearance - r_c
+    for i, t in ((0, o.bottom_radius), (2, o.barrel_radius)):
+        estimate = np.max(delta * (1.0 - np.cos(np.arctan(v / t) - np.arctan(v / o.pitch_station))))
+        assert dev[i, :, 1] == pytest.approx(estimate, rel=0.15)
+        assert estimate > 0.002
+
+
+@pytest.mark.parametrize(
+    ("field", "change"),
+    [
+        ("gcode.rough_diameter", {"rough_diameter": 16.0}),
+        ("gcode.step_down", {"step_down": 0.0}),
+        ("gcode.stock", {"stock": -1.0}),
+        ("gcode.tolerance", {"tolerance": float("nan")}),
+    ],
+)
+def test_bad_options_name_their_field(field, change):
+    """Each bad option is refused naming its field."""
+    spec = replace(BarrelToolpathOptions(), **change)
+    with pytest.raises(DesignError) as err:
+        plan_barrel(INDEXER.program, INDEXER.follower, INDEXER.options, spec)
+    assert err.value.path == field
+
+
+def test_a_conical_roller_is_refused_naming_the_field():
+    from camcad.geometry.barrel import RollerShape
+
+    options = replace(INDEXER.options, roller=RollerShape.CONICAL)
+    with pytest.raises(DesignError) as err:
+        plan_barrel(INDEXER.program, INDEXER.follower, options, BarrelToolpathOptions())
+    assert err.value.path == "follower.roller"
