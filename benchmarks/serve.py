@@ -9,7 +9,8 @@ Selenium are installed, the latency a designer sees: from the change event of
 an edit (the base radius, committed as on leaving the field) to the page
 redrawn (cards, drawing, uPlot charts, one animation frame after), measured by
 the page itself (``body.dataset.latency``) against a real ``camcad serve``,
-median of ``REPEATS`` edits. Prints Markdown tables.
+median of ``REPEATS`` edits. Prints Markdown tables, with the load average
+before and after.
 """
 
 from __future__ import annotations
@@ -78,9 +79,15 @@ def browser_latency() -> list[str]:
                 threading.Thread(target=srv.serve_forever, daemon=True).start()
                 try:
                     driver.get(url)
-                    _wait(
-                        driver, "document.body.dataset.state === 'ok' && document.body.dataset.busy === '0'"
-                    )
+                    try:
+                        _wait(
+                            driver,
+                            "document.body.dataset.state === 'ok' && document.body.dataset.busy === '0'",
+                            seconds=30.0,
+                        )
+                    except TimeoutError:  # the page never drew this design (a server error): say so, go on
+                        lines.append(f"| {path.stem} | (no answer) | | |")
+                        continue
                     times, fetches, draws = [], [], []
                     for i in range(REPEATS + 1):
                         rev = driver.execute_script("return +document.body.dataset.revision")
@@ -105,8 +112,17 @@ def browser_latency() -> list[str]:
     return lines
 
 
+def _load() -> str:
+    """The machine's load average (1, 5, 15 min): the timings mean little on a busy machine."""
+    import os
+
+    return "load average " + ", ".join(f"{x:.2f}" for x in os.getloadavg()) + f" on {os.cpu_count()} CPUs"
+
+
 def main() -> None:
     """Measure and print."""
+    print(_load())
+    print()
     lines = ["| sample | evaluate [ms] | JSON [ms] | answer [kB] |", "|---|---:|---:|---:|"]
     for path in sorted((ROOT / "samples").glob("*.toml")):
         data = tomllib.loads(path.read_text(encoding="utf-8"))
@@ -125,6 +141,8 @@ def main() -> None:
     print("\n".join(lines))
     print()
     print("\n".join(browser_latency()))
+    print()
+    print(_load())
 
 
 if __name__ == "__main__":

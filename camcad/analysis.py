@@ -7,6 +7,7 @@ sits below the report and the pipeline: both read it, neither is imported here.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
@@ -27,6 +28,7 @@ from camcad.motion.table import table_summary
 
 if TYPE_CHECKING:
     from camcad.dynamics.duty import DutyResult
+    from camcad.dynamics.vibration import VibrationResult
     from camcad.export.gcode import GcodeProgram
     from camcad.fea.results import FeaResult  # only typing: the FE package loads when the check runs
     from camcad.toolpath import Toolpath
@@ -102,6 +104,10 @@ class Analysis:
     stage_findings: tuple[Finding, ...] = ()
     fea: FeaResult | None = None  # the finite-element check, when run ([fea] present, or asked for)
     duty: DutyResult | None = None  # life, film and drive ([life], [lubrication], [drive]; issue 35)
+    vibration: VibrationResult | None = None  # the elastic follower train ([vibration]; issue 34)
+    _memo: dict[str, Any] = field(  # the motion summary, computed once (see summary)
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     @property
     def cam(self) -> Cam:
@@ -140,6 +146,7 @@ class Analysis:
             *self.stage_findings,
             *(self.fea.findings if self.fea is not None else ()),
             *(self.duty.findings if self.duty is not None else ()),
+            *(self.vibration.findings if self.vibration is not None else ()),
         )
         return tuple(sorted(found, key=lambda f: not f.hard))
 
@@ -148,7 +155,8 @@ class Analysis:
         """Every non-fatal message of every stage: soft findings and notes."""
         fea = list(self.fea.warnings) if self.fea is not None else []
         duty = [f.message for f in self.duty.findings] if self.duty is not None else []
-        return [*self.geometry.warnings, *self.dynamics.warnings, *fea, *duty]
+        vib = [f.message for f in self.vibration.findings if not f.hard] if self.vibration is not None else []
+        return [*self.geometry.warnings, *self.dynamics.warnings, *fea, *duty, *vib]
 
     @property
     def violations(self) -> list[str]:
@@ -156,11 +164,18 @@ class Analysis:
         return list(dict.fromkeys(f.kind for f in self.findings))
 
     def summary(self) -> dict[str, Any]:
-        """The content of ``summary.json``."""
+        """The content of ``summary.json``; a new dict on each call, the caller's to change.
+
+        The motion's true peaks are refined once per analysis and copied from
+        then on: the report, its cards and its warning banner each ask for the
+        summary, and the designer draws all three after every edit.
+        """
+        if "motion" not in self._memo:
+            self._memo["motion"] = motion_summary(self.cam, self.motion)
         out: dict[str, Any] = {
             "camcad_version": __version__,
             "design": {"name": self.design.cam.name, "source": self.design.source},
-            "motion": motion_summary(self.cam, self.motion),
+            "motion": copy.deepcopy(self._memo["motion"]),
             "geometry": self.geometry.summary(),
             "dynamics": self.dynamics.summary(),
             **self.family.summary(self.parts),  # a groove's flanks, a pair's second plate
@@ -173,6 +188,8 @@ class Analysis:
             out["fea"] = self.fea.summary()
         if self.duty is not None:
             out |= self.duty.summary()  # life, lubrication, drive
+        if self.vibration is not None:
+            out["vibration"] = self.vibration.summary()
         out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]
@@ -199,20 +216,14 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
 
     def rows(p: FloatArray, side: Side) -> FloatArray:
         m = cam.motion(p, side=side)
-        return np.abs(np.vstack((m.v, m.a, m.j)))
+        return np.vstack((np.abs(np.vstack((m.v, m.a, m.j))), m.s, m.s))
 
-    values = np.abs(np.vstack((motion.v, motion.a, motion.j)))
-    peaks = extremes_rows(rows, motion.phi, joints, ("max", "max", "max"), values=values)
-
-    def travel(p: FloatArray, side: Side) -> FloatArray:
-        s = cam.motion(p, side=side).s
-        return np.vstack((s, s))
-
-    # the true stroke: the follower's travel max − min over the turn, refined on the exact motion (a
-    # segment that overshoots, as a return out of a constant-velocity rise does, can exceed the lift)
-    top, bottom = extremes_rows(
-        travel, motion.phi, joints, ("max", "min"), values=np.vstack((motion.s, motion.s))
-    )
+    # |v|, |a|, |j| and the true stroke, the follower's travel max − min over the turn, refined on the
+    # exact motion in one search (a segment that overshoots, as a return out of a constant-velocity rise
+    # does, can exceed the lift)
+    values = np.vstack((np.abs(np.vstack((motion.v, motion.a, motion.j))), motion.s, motion.s))
+    found = extremes_rows(rows, motion.phi, joints, ("max", "max", "max", "max", "min"), values=values)
+    peaks, (top, bottom) = found[:3], found[3:]
     out[f"stroke_{u}"] = top.value - bottom.value
     out[f"travel_max_{u}"] = top.value
     out["travel_max_angle_deg"] = top.angle_deg

@@ -339,9 +339,17 @@ class Result:
     design : Design
         The design analysed.
     lift : Quantity
-        The largest lift [mm], or swing [°] for an arm (``lift_unit``).
+        The nominal lift the program states [mm], or swing [°] for an arm (``lift_unit``).
+    stroke, travel_min, travel_max : Quantity
+        The follower's true travel over the turn, max − min of s, and its two ends
+        (true extremes, with their cam angles): larger than ``lift`` where a
+        segment overshoots (a return carried forwards by a constant-velocity rise).
     max_pressure_angle, pressure_angle_limit : Quantity
         The largest pressure angle |α| and the design's limit [°].
+    pressure_angle_flank : str or None
+        A groove cam's flank that drives where |α| is largest ("inner" or "outer"); None for other cams.
+    contact_stress_flank : str or None
+        A groove cam's flank that carries ``max_contact_stress`` ("inner" or "outer"); None for other cams.
     min_curvature_radius, min_concave_radius : Quantity
         The smallest convex and concave radius of curvature of the profile [mm].
     max_torque : Quantity
@@ -389,8 +397,26 @@ class Result:
         arm = "lift_deg" in motion
         self.lift_unit = "°" if arm else "mm"
         self.lift = Quantity(value=float(motion["lift_deg" if arm else "lift_mm"]), unit=self.lift_unit)
+        u = "deg" if arm else "mm"
+        self.stroke = Quantity(
+            value=float(motion[f"stroke_{u}"]),
+            unit=self.lift_unit,
+            angle_deg=motion.get("travel_max_angle_deg"),
+        )
+        self.travel_min = Quantity(
+            value=float(motion[f"travel_min_{u}"]),
+            unit=self.lift_unit,
+            angle_deg=motion.get("travel_min_angle_deg"),
+        )
+        self.travel_max = Quantity(
+            value=float(motion[f"travel_max_{u}"]),
+            unit=self.lift_unit,
+            angle_deg=motion.get("travel_max_angle_deg"),
+        )
         self.max_pressure_angle = _quantity(geo, "pressure_angle_max", "°")
         self.pressure_angle_limit = Quantity(value=math.degrees(design.spec.cam.max_pressure_angle), unit="°")
+        groove = summary.get("groove") or {}
+        self.pressure_angle_flank: str | None = groove.get("pressure_angle_max_flank")
         self.min_curvature_radius = _quantity(geo, "curvature_radius_min", "mm")
         self.min_concave_radius = _quantity(geo, "concave_radius_min", "mm")
         self.undercut: bool = bool(geo["undercut"])
@@ -398,6 +424,7 @@ class Result:
         self.max_contact_force = _quantity(dyn, "contact_force_max", "N")
         self.min_contact_force = _quantity(dyn, "contact_force_min", "N")
         self.max_contact_stress = _quantity(dyn, "hertz_stress_max", "MPa")
+        self.contact_stress_flank: str | None = dyn.get("hertz_stress_max_flank")
         positive = analysis.dynamics.positive_drive  # no spring holds it on: no jump check
         self.follower_jump: bool | None = None if positive else dyn.get("jump")
         self.fit_control_points: int | None = None if fit is None else int(fit["control_points"])

@@ -199,6 +199,44 @@ def _duty_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     return rows
 
 
+def _vibration_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+    """The rows ``[vibration]`` adds to ``camcad check`` (issue 34): the elastic train at the design speed."""
+    vib = summary.get("vibration")
+    if vib is None:
+        return []
+    unit = "mm" if "error_peak_mm" in vib else "deg"
+    shown = " mm" if unit == "mm" else "°"
+    force = " N" if unit == "mm" else " N·mm"
+    at = f" at {vib['speed_rpm']:g} rpm"
+    rows = [
+        ("natural frequency", ", ".join(f"{f:.4g} Hz" for f in vib["natural_frequencies_hz"])),
+        (
+            "peak dynamic error",
+            f"{vib[f'error_peak_{unit}']:.4g}{shown} at {vib['error_peak_angle_deg']:.1f}°{at}",
+        ),
+        (
+            "min dynamic contact force",
+            f"{vib['contact_force_min']:.4g}{force} at {vib['contact_force_min_angle_deg']:.1f}°{at}",
+        ),
+    ]
+    for k, value in enumerate(vib[f"residual_{unit}"], start=1):
+        rows.append((f"residual in dwell {k}", f"{value:.4g}{shown}"))
+    flights = vib["flights"]
+    leaves = "no"
+    if vib["leaves_cam"]:
+        leaves = "yes" + (f", at {flights[0]['leave_deg']:.1f}°" if flights else "")
+    rows.append(("leaves the cam", leaves))
+    if "compensate_rpm" in vib:
+        rows.append(
+            (
+                "polydyne lift correction",
+                f"max |c − s| {vib[f'lift_correction_max_{unit}']:.4g}{shown}"
+                f" (tuned for {vib['compensate_rpm']:g} rpm)",
+            )
+        )
+    return rows
+
+
 def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     """The rows a groove or a conjugate pair adds to ``camcad check``: flanks, second plate, crossovers."""
     rows: list[tuple[str, str]] = []
@@ -279,6 +317,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     analysis = analyse(design, strict=False, toolpath=False, fea=args.fea or design.fea is not None)
     rows = _check_rows(analysis.summary(), design) + _positive_rows(analysis.summary())
     rows += _duty_rows(analysis.summary())
+    rows += _vibration_rows(analysis.summary())
     if analysis.fea is not None:
         rows += _fea_rows(analysis.summary()["fea"])
     width = max(len(k) for k, _ in rows)
@@ -461,6 +500,136 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _toml_of(path: str) -> dict[str, Any]:
+    """The TOML mapping of a design file the schema has just accepted (``tolerance``, ``inspect``)."""
+    import tomllib
+
+    data: dict[str, Any] = tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
+    return data
+
+
+def _cmd_tolerance(args: argparse.Namespace) -> int:
+    from camcad.design import load_design
+    from camcad.design.schema import parse_tolerance
+    from camcad.errors import DesignError
+    from camcad.explore.tolerance import tolerance_study
+    from camcad.geometry.cam import Cam
+
+    design = load_design(args.design)
+    data = _toml_of(args.design)
+    if "tolerance" not in data:
+        raise DesignError(
+            "tolerance", f"{args.design} has no [tolerance] table; see the README's [tolerance] keys"
+        )
+    spec = parse_tolerance(data["tolerance"], design)
+
+    def report(done: int, total: int) -> None:
+        print(f"\r  {done}/{total} chunks", end="" if done < total else "\n", file=sys.stderr, flush=True)
+
+    jobs = args.jobs if args.jobs is not None else (os.cpu_count() or 1)
+    result = tolerance_study(
+        Cam.from_design(design),
+        spec,
+        args.output,
+        name=design.cam.name,
+        source=args.design,
+        fmt=args.format,
+        jobs=jobs,
+        scheduler=args.scheduler,
+        progress=None if args.quiet or not sys.stderr.isatty() else report,
+    )
+    summary = result.summary
+    unit = summary["lift_unit"]
+    for k, dwell in enumerate(summary["dwells"]):
+        text = f"dwell {k} at {dwell['angle_deg']:.1f}°: linear σ {dwell['linear']['sigma']:.4g} {unit}, "
+        text += f"worst case {dwell['linear']['worst_case']:.4g} {unit}"
+        if "monte_carlo" in dwell:
+            lo, hi = dwell["monte_carlo"]["percentiles"][0], dwell["monte_carlo"]["percentiles"][-1]
+            text += f"; Monte Carlo 99.73 % within {lo:.4g} to {hi:.4g} {unit}"
+        print(text)
+    alloc = summary["allocation"]
+    if alloc is not None:
+        largest = ", ".join(
+            f"{k} ±{v:.4g}" if v is not None else f"{k} any" for k, v in alloc["largest_tolerances"].items()
+        )
+        verdict = "meet" if alloc["given_tolerances_meet_it"] else "do not meet"
+        print(
+            f"allocation for ±{alloc['dwell_accuracy']:g} {unit} ({alloc['method']}, confidence "
+            f"{alloc['confidence']:g}): {largest}; the given tolerances {verdict} it"
+        )
+    for path in result.files:
+        print(f"wrote {path}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _inspect_band(args: argparse.Namespace, design_path: str, design: Any) -> float:
+    """--band, or the design's [tolerance] form tolerance (±t; a σ as 3σ)."""
+    from camcad.errors import UsageError
+
+    if args.band is not None:
+        if not (math.isfinite(args.band) and 0.0 < args.band <= 10.0):
+            raise UsageError("--band", f"{args.band!r} mm is not allowed (allowed: over 0 up to 10 mm)")
+        return float(args.band)
+    data = _toml_of(design_path)
+    if "tolerance" in data:
+        from camcad.design.schema import parse_tolerance
+        from camcad.geometry.sensitivity import Tol
+
+        for t in parse_tolerance(data["tolerance"], design).tolerances:
+            if t.tol is Tol.FORM:
+                return t.value
+    raise UsageError("--band", "give the tolerance band in mm (or form_pm in the design's [tolerance] table)")
+
+
+def _cmd_inspect(args: argparse.Namespace) -> int:
+    from camcad.design import load_design
+    from camcad.design.table_file import read_table_file
+    from camcad.errors import UsageError
+    from camcad.explore.inspection import inspect_measured
+    from camcad.inspect.measured import parse_measured
+
+    design = load_design(args.design)
+    band = _inspect_band(args, args.design, design)
+    for flag, value in (("--stock", args.stock), ("--tool-diameter", args.tool_diameter)):
+        if value is not None and not (math.isfinite(value) and 0.0 <= value <= 1000.0):
+            raise UsageError(flag, f"{value!r} mm is not allowed (allowed: 0 to 1000 mm)")
+    if args.tool_diameter is not None and args.stock is None:
+        raise UsageError("--tool-diameter", "a compensated program needs --stock too")
+    if args.tool_diameter == 0.0:
+        raise UsageError("--tool-diameter", "0 mm is not allowed (allowed: over 0 up to 1000 mm)")
+    text = read_table_file(args.measured, folder=None, where=args.measured)
+    measured = parse_measured(text, where=args.measured)
+    result = inspect_measured(
+        design,
+        measured,
+        args.output,
+        where=args.measured,
+        band=band,
+        stock=args.stock,
+        tool_diameter=args.tool_diameter,
+    )
+    s = result.summary
+    fit, dev = s["fit"], s["deviation"]
+    print(f"{s['design']}: {s['points']} points ({s['layout']}) from {args.measured}")
+    print(
+        f"  fit: turn {fit['rotation_deg']:.4f}° ± {fit['rotation_sigma_deg']:.4f}°, cam axis at "
+        f"({fit['centre_mm'][0]:.4f}, {fit['centre_mm'][1]:.4f}) mm "
+        f"± {max(fit['centre_sigma_mm']) * 1000:.2f} µm"
+    )
+    print(
+        f"  deviation {dev['min_mm'] * 1000:.2f} to {dev['max_mm'] * 1000:.2f} µm (band ±{band * 1000:g} µm, "
+        f"scatter {dev['noise_mm'] * 1000:.2f} µm); {s['outside']} points outside"
+    )
+    for path in result.files:
+        print(f"wrote {path}", file=sys.stderr)
+    if not result.passed:
+        lines = ", ".join(str(n) for n in s["outside_lines"][:10]) + (", …" if s["outside"] > 10 else "")
+        print(f"the part is outside its band at {s['outside']} points (lines {lines})")
+        return EXIT_LIMIT
+    print("the part is within its band")
+    return EXIT_OK
+
+
 def _cmd_serve(args: argparse.Namespace) -> int:
     from camcad.errors import UsageError
     from camcad.serve import serve
@@ -611,6 +780,36 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="folder for sweep.parquet (or .csv) and sweep.html")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     p.set_defaults(handler=_cmd_sweep)
+
+    p = sub.add_parser(
+        "tolerance", help="tolerance study of a design's [tolerance] table (Monte Carlo or linear)"
+    )
+    p.add_argument("design", help="design file (TOML) with a [tolerance] table")
+    p.add_argument("--format", default="parquet", help="table format: parquet (default) or csv")
+    p.add_argument("--jobs", type=int, help="local worker processes (default: every core; 1: this process)")
+    p.add_argument("--scheduler", help="a Dask scheduler address, e.g. tcp://host:8786 (instead of --jobs)")
+    p.add_argument("-o", "--output", required=True, help="folder for tolerance.parquet, .json and .html")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    p.set_defaults(handler=_cmd_tolerance)
+
+    p = sub.add_parser(
+        "inspect", help="a measured cam (CMM points) against its design; exit 3 outside the band"
+    )
+    p.add_argument("design", help="design file (TOML)")
+    p.add_argument(
+        "measured", help="measured points: CSV with a header x, y (mm) or angle (deg), radius (mm)"
+    )
+    p.add_argument("--band", type=float, help="tolerance band ± mm (default: the design's tolerance.form_pm)")
+    p.add_argument(
+        "--stock", type=float, help="write a compensated cam.ngc and profile.dxf; the most it may cut, mm"
+    )
+    p.add_argument(
+        "--tool-diameter", type=float, help="tool of the compensated program, mm (default [gcode])"
+    )
+    p.add_argument(
+        "-o", "--output", required=True, help="folder for inspection.csv, .json, .html, actual_motion.csv"
+    )
+    p.set_defaults(handler=_cmd_inspect)
     return parser
 
 

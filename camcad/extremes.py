@@ -234,6 +234,22 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
     )
 
 
+def _without_rests(b: _Brackets, rests: Sequence[tuple[float, float]]) -> _Brackets:
+    """The brackets that do not lie within one of the ``rests`` (intervals [rad] where every row is flat)."""
+    if not len(rests) or not b.x1.size:
+        return b
+    span = np.asarray(rests, dtype=float).reshape(-1, 2)
+    inside: np.ndarray = np.any((b.x1[:, None] >= span[:, 0]) & (b.x3[:, None] <= span[:, 1]), axis=1)
+    return _select(b, np.logical_not(inside))
+
+
+def _select(b: _Brackets, keep: np.ndarray) -> _Brackets:
+    """The brackets where ``keep`` (bool) is True."""
+    if keep.all():
+        return b
+    return _Brackets(b.row[keep], b.x1[keep], b.x2[keep], b.x3[keep], b.f1[keep], b.f2[keep], b.f3[keep])
+
+
 def _probe_end_gaps(f: _Picker, b: _Brackets) -> _Brackets:
     """Bracket the maxima hidden in the first or last sample gap of a piece, or drop the gap.
 
@@ -255,8 +271,10 @@ def _probe_end_gaps(f: _Picker, b: _Brackets) -> _Brackets:
     f_probes = f(probes.ravel(), np.repeat(gap, _END_PROBES.size)).reshape(probes.shape)
     pts = np.column_stack((lo, probes, hi))
     fs = np.column_stack((b.f1[gap], f_probes, b.f3[gap]))
-    j = np.argmax(fs, axis=1)
-    hit = (j > 0) & (j < pts.shape[1] - 1)
+    # a probe must beat both ends: one that only ties the end (the top of a rise, flat to round-off
+    # there) shows nothing rising above it
+    j = 1 + np.argmax(fs[:, 1:-1], axis=1)
+    hit = fs[np.arange(gap.size), j] > np.maximum(fs[:, 0], fs[:, -1])
     keep = np.ones(b.x1.size, bool)
     keep[gap[~hit]] = False
     g, jj, k = gap[hit], j[hit], np.flatnonzero(hit)
@@ -304,6 +322,8 @@ def _refine_max(f: _Picker, b: _Brackets) -> tuple[FloatArray, FloatArray]:
             u = x - num / den
         inside = np.isfinite(u) & (u > a + tol) & (u < b_ - tol)
         live &= ~(inside & (np.abs(u - x) <= _XSTOP))  # the parabola's vertex is the point itself
+        if not live.any():
+            break
         usable = inside & (np.abs(u - x) > tol) & (np.abs(u - u_prev) > tol)  # no stalling on one point
         golden = np.where(x - a > b_ - x, x - _GOLDEN_SECTION * (x - a), x + _GOLDEN_SECTION * (b_ - x))
         u = np.where(usable, u, golden)
@@ -330,6 +350,8 @@ def extremes_rows(
     kinds: Sequence[Kind],
     *,
     values: ArrayLike | None = None,
+    rests: Sequence[tuple[float, float]] = (),
+    settled: Sequence[bool] = (),
 ) -> tuple[Extreme, ...]:
     """The true extremes of several quantities at once, one per row of ``quantity``.
 
@@ -345,6 +367,19 @@ def extremes_rows(
         ``"min"`` or ``"max"`` for each row.
     values
         (k, n) ``quantity(grid, "right")`` if already computed.
+    rests
+        Intervals [start, end] [rad] of [0, 2π] over which every row is
+        constant (the motion's dwells, where the follower stands still). A
+        sampled "extremum" inside one is round-off on a flat stretch: it is
+        not refined, and the samples there, both ends included, stand for
+        the constant. Without them such a bracket is searched to the end
+        (some forty evaluations) and kept only if it beats the samples by
+        more than round-off, which it cannot.
+    settled
+        For each row (or none): True where the row takes only a few constant
+        values over the whole turn (0 or ±inf, say, as a bound that is
+        identically zero where it applies), so that its sampled extreme is
+        exact and no search can beat it.
 
     Returns
     -------
@@ -372,7 +407,10 @@ def extremes_rows(
         )
         for r in range(k)
     ]
-    br = _brackets(seq, val, best)
+    br = _without_rests(_brackets(seq, val, best), rests)
+    if any(settled):
+        searched: np.ndarray = np.logical_not(np.asarray(settled, dtype=bool))[br.row]
+        br = _select(br, searched)
     picker = _Picker(quantity, sign[:, 0], br.row, k)
     br = _probe_end_gaps(picker, br)
     if br.x1.size:

@@ -56,6 +56,8 @@ OUTPUT_GROUPS: dict[str, tuple[str, ...]] = {
         "lift.csv",
         "polar.txt",
         "cam_table.csv",
+        "vibration.csv",  # with [vibration] (issue 34)
+        "speed_map.csv",
     ),
     "dxf": ("profile.dxf", "profile_poly.dxf", "profile_arcs.dxf"),
     "stl": ("cam.stl",),
@@ -143,6 +145,16 @@ def analyse(
     """
     timings: dict[str, float] = {}
     cam = Cam.from_design(design)
+    vibration = None
+    if design.vibration is not None:  # issue 34: the elastic train; a polydyne cam is cut from its lift c
+        vibration = _timed(timings, progress, "vibration", lambda: _vibration(design, cam))
+        stop = [f for f in vibration.findings if f.hard]  # the follower leaves a spring-loaded cam
+        if stop and strict:
+            raise DesignLimitError(f"{stop[0].field}: {stop[0].message}")
+        if vibration.compensated is not None:
+            from camcad.dynamics.vibration import compensated_program
+
+            cam = replace(cam, program=compensated_program(vibration.compensated))
     family = family_of(design.cam.style)
     parts = family.parts(cam, design.family_options())  # plate; a groove's blank; a pair's two plates
 
@@ -280,6 +292,23 @@ def analyse(
         stage_findings=tuple(later),
         fea=fea_result,
         duty=duty,
+        vibration=vibration,
+    )
+
+
+def _vibration(design: Design, cam: Cam) -> Any:
+    """The ``[vibration]`` analysis of the design's motion program at its speed (issue 34)."""
+    from camcad.dynamics.vibration import analyse_vibration
+
+    assert design.vibration is not None
+    setup = design.dynamics_setup()
+    return analyse_vibration(
+        cam.program,
+        design.vibration,
+        design.dynamics,
+        speed_rpm=design.cam.speed_rpm,
+        arm_angle=setup.arm_angle,
+        spring_loaded=not setup.positive_drive,
     )
 
 
@@ -615,7 +644,7 @@ def _fitted(result: PartResult) -> ProfileFit:
 
 
 def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
-    """motion.csv, profile.csv, dynamics.csv, points.csv and lift.csv into ``folder``."""
+    """motion.csv, profile.csv, dynamics.csv, points.csv, lift.csv and the optional tables into ``folder``."""
     from camcad.export.tables import (
         write_dynamics_csv,
         write_lift_csv,
@@ -638,6 +667,23 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
         write_lift_csv(folder / "lift.csv", cam, design.tables),
         *_polar_table(analysis, folder),
         *_drive_table(analysis, folder),
+        *_vibration_tables(analysis, folder),
+    ]
+
+
+def _vibration_tables(analysis: Analysis, folder: Path) -> list[Path]:
+    """vibration.csv (the response at the design speed) and speed_map.csv, with ``[vibration]``."""
+    vib = analysis.vibration
+    if vib is None:
+        return []
+
+    def text(rows: list[tuple[str, ...]]) -> str:
+        cells = (("0" + c[2:] if c.startswith("-0") and float(c) == 0.0 else c for c in r) for r in rows)
+        return "\n".join(",".join(r) for r in cells) + "\n"  # no "-0": the same table everywhere
+
+    return [
+        write_text(folder / "vibration.csv", text(vib.response_rows())),
+        write_text(folder / "speed_map.csv", text(vib.speed_map_rows())),
     ]
 
 

@@ -566,6 +566,21 @@ def _duty_section(analysis: Analysis) -> str:
     )
 
 
+def _vibration_section(analysis: Analysis) -> str:
+    """The elastic follower train (issue 34): the speed map and the response at the design speed."""
+    if getattr(analysis, "vibration", None) is None:
+        return ""
+    from camcad._plots.vibration import vibration_plots
+
+    figures = "".join(_img(p) for p in vibration_plots(analysis))
+    return (
+        '<h2 id="vibration-heading">Cams at speed</h2>\n<section id="vibration">'
+        "<p>The follower train as the <code>[vibration]</code> table states it; the numbers are in the "
+        "table <i>Vibration</i> below, vibration.csv and speed_map.csv.</p>"
+        f'<section class="plots">{figures}</section></section>'
+    )
+
+
 def render_report(analysis: Analysis) -> str:
     """The HTML report of one analysed design.
 
@@ -612,6 +627,7 @@ def render_report(analysis: Analysis) -> str:
             f'<h2 id="plots-heading">Plots</h2>\n<section class="plots" id="plots">{rest}</section>',
             _fea_section(analysis),
             _duty_section(analysis),
+            _vibration_section(analysis),
             "<h2>Tables</h2>",
             _summary_tables(analysis, summary),
             f"<footer>camcad {_e(version)} · angles in degrees, lengths in mm</footer>",

@@ -31,7 +31,7 @@ import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -41,12 +41,14 @@ from camcad.dynamics.drive import DriveMode, DriveSpec
 from camcad.dynamics.film import LubricationSpec
 from camcad.dynamics.life import ROLLER_EXPONENT, LifeSpec, LoadStressLine
 from camcad.dynamics.spec import DynamicsModel, DynamicsSpec
+from camcad.dynamics.vibration.spec import TrainModel, VibrationSpec
 from camcad.errors import DesignError, ValueRuleError
 from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec, PlaneModel
 from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import Cam
 from camcad.geometry.families import FAMILIES, FamilyOptions, family_of
+from camcad.geometry.sensitivity import Tol
 from camcad.geometry.spec import (
     CamStyle,
     ConjugateSpec,
@@ -70,12 +72,15 @@ from camcad.motion.table import (
 )
 from camcad.toolpath.spec import Cutter, Machine, RotaryAxis
 
+if TYPE_CHECKING:
+    from camcad.inspect.spec import ToleranceSpec
+
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - exercised on Python 3.10 only
     import tomli as tomllib
 
-__all__ = ["load_design", "parse_design"]
+__all__ = ["load_design", "parse_design", "parse_tolerance"]
 
 FULL_TURN_DEG = 360.0
 ANGLE_SUM_TOL_DEG = 1e-9
@@ -305,6 +310,41 @@ _mesh_formats = _Check(
 )
 
 
+# [tolerance] (issue 38, ``camcad tolerance``): each toleranced quantity as ±t (``<q>_pm``, uniform
+# over ±t) or one standard deviation (``<q>_sigma``, normal); the design-file name → camcad's Tol
+_TOLERANCED: dict[str, Tol] = {
+    "form": Tol.FORM,
+    "roller_radius": Tol.ROLLER_RADIUS,
+    "offset": Tol.ECCENTRICITY,
+    "centre_distance": Tol.CENTRE_DISTANCE,
+    "pivot_x": Tol.PIVOT_X,
+    "pivot_y": Tol.PIVOT_Y,
+    "arm_length": Tol.ARM_LENGTH,
+    "face_offset": Tol.FACE_OFFSET,
+    "phase_deg": Tol.PHASE,
+}
+_StudyWord = enum.Enum("_StudyWord", [("MONTE_CARLO", "monte-carlo"), ("LINEAR", "linear")])
+_AllocationWord = enum.Enum("_AllocationWord", [("RSS", "rss"), ("WORST_CASE", "worst-case")])
+_TOLERANCE_RULES: dict[str, _Rule] = {
+    **{
+        f"{name}_{how}": _Rule(
+            "float",
+            check=_below(90.0, "degrees")
+            if tol is Tol.PHASE
+            else _between(0.0, MAX_TOLERANCE_MM, " mm", lo_open=True),
+        )
+        for name, tol in _TOLERANCED.items()
+        for how in ("pm", "sigma")
+    },
+    "samples": _Rule("int", check=_count(2, 1_000_000, "Monte-Carlo variants")),
+    "seed": _Rule("int", check=_count(0, 2**32 - 1, "a seed of NumPy's generator")),
+    "method": _Rule("enum", enum=_StudyWord),  # camcad.inspect.spec.StudyMethod
+    "dwell_accuracy": _Rule("float", check=_between(0.0, MAX_TOLERANCE_MM, " mm (° of swing)", lo_open=True)),
+    "confidence": _Rule("float", check=_interval(0.0, 1.0, lo_open=True, hi_open=True)),
+    "allocation": _Rule("enum", enum=_AllocationWord),  # camcad.inspect.tolerance.Method
+}
+
+
 _SECTIONS: dict[str, dict[str, _Rule]] = {
     "cam": {
         "name": _Rule("str", check=_name),
@@ -426,6 +466,25 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "screw_lead_mm": _Rule("float", check=_length),
         "axis_friction": _Rule("float", check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N or N·mm")),
     },
+    "vibration": {  # issue 34: the elastic follower train, speed map and polydyne cam (dynamics.vibration)
+        "model": _Rule("enum", enum=TrainModel),
+        "stiffness": _Rule("float", check=_between(0.0, MAX_FORCE_N, " N/mm", lo_open=True)),
+        "stiffness_torsional": _Rule(
+            "float", check=_between(0.0, MAX_FORCE_N * MAX_LENGTH_MM, " N·mm/rad", lo_open=True)
+        ),
+        "damping_ratio": _Rule("float", check=_fraction),
+        "mass_1": _Rule("float", check=_between(0.0, MAX_MASS_KG, " kg", lo_open=True)),
+        "mass_2": _Rule("float", check=_between(0.0, MAX_MASS_KG, " kg", lo_open=True)),
+        "stiffness_2": _Rule("float", check=_between(0.0, MAX_FORCE_N, " N/mm", lo_open=True)),
+        "speed_min_rpm": _Rule("float", check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "speed_max_rpm": _Rule("float", check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "speed_points": _Rule("int", check=_count(1, 10_000, "speeds in speed_map.csv")),
+        "compensate_rpm": _Rule("float", check=_between(0.0, MAX_SPEED_RPM, " rpm", lo_open=True)),
+        "max_residual": _Rule(
+            "float", check=_between(0.0, MAX_LENGTH_MM, " mm (degrees on an arm)", lo_open=True)
+        ),
+    },
+    "tolerance": _TOLERANCE_RULES,  # issue 38: camcad tolerance (parse_tolerance)
     "tables": {
         "step_deg": _Rule("float", check=_table_step, scale=DEG, attr="step"),
         "wheel_radius": _Rule("float", check=_length_or_zero),
@@ -925,6 +984,42 @@ def _check_service(design: Design) -> None:
         )
 
 
+def _check_vibration(design: Design) -> None:
+    """``[vibration]`` (issue 34) against the follower, the drive, the speed and the laws (exit 2)."""
+    vib = design.vibration
+    if vib is None:
+        return
+    from camcad.dynamics.vibration import check_compensable, train_from_specs
+
+    arm = design.follower.kind.oscillating
+    wrong = "stiffness" if arm else "stiffness_torsional"
+    if getattr(vib, wrong) is not None:
+        right = "stiffness_torsional (N·mm/rad about the pivot)" if arm else "stiffness (N/mm)"
+        raise DesignError(
+            f"vibration.{wrong}", f"does not apply to a {design.follower.kind.value} follower; give {right}"
+        )
+    setup = design.dynamics_setup()
+    train_from_specs(vib, design.dynamics, arm_angle=setup.arm_angle)  # required keys, masses, rates
+    speed = design.cam.speed_rpm
+    lo = vib.speed_min_rpm if vib.speed_min_rpm is not None else 0.5 * speed
+    hi = vib.speed_max_rpm if vib.speed_max_rpm is not None else 1.5 * speed
+    if not lo < hi:
+        field = "speed_max_rpm" if vib.speed_max_rpm is not None else "speed_min_rpm"
+        raise DesignError(
+            f"vibration.{field}",
+            f"the speed map's range {lo:g} to {hi:g} rpm is empty (the default range is 0.5 to 1.5 times "
+            f"cam.speed_rpm = {speed:g}); allowed: speed_min_rpm < speed_max_rpm",
+        )
+    if vib.compensate_rpm is not None:
+        if setup.positive_drive:
+            raise DesignError(
+                "vibration.compensate_rpm",
+                f"a {design.cam.style.value} cam drives its follower both ways (no return spring to tune "
+                "against); allowed: compensate_rpm on a spring-loaded plate cam only",
+            )
+        check_compensable(MotionProgram.from_segments(design.motion))
+
+
 def _check_design(design: Design) -> None:
     """The checks across fields, each naming the field to change."""
     _check_follower(design)
@@ -935,6 +1030,7 @@ def _check_design(design: Design) -> None:
     _check_gcode(design)
     _check_fea(design)
     _check_service(design)
+    _check_vibration(design)
 
 
 def _check_follower(design: Design) -> None:
@@ -1255,6 +1351,8 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
     if "fea" in data:  # present or not decides whether a build runs the FE check
         specs["fea"] = FeaSpec(**_section("fea", data["fea"]))
     specs |= _service_tables(data)  # [life], [lubrication], [drive] (issue 35)
+    if "vibration" in data:  # issue 34
+        specs["vibration"] = VibrationSpec(**_section("vibration", data["vibration"]))
     own = family_of(specs["cam"].style).table
     for family in FAMILIES.values():  # after their values, so a bad value names its own key
         table = family.table
@@ -1278,7 +1376,80 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
     motion = _finish_motion(motion, unit="°" if follower.kind.oscillating else " mm")
     design = Design(motion=motion, source=source, **specs)
     _check_design(design)
+    if "tolerance" in data:  # checked with the design; camcad tolerance reads it (parse_tolerance)
+        parse_tolerance(data["tolerance"], design)
     return design
+
+
+def parse_tolerance(table: Any, design: Design) -> ToleranceSpec:
+    """The ``[tolerance]`` table (issue 38) of a validated design, checked against its follower.
+
+    A quantity is given as ±t (``<q>_pm``: uniform over ±t) or as one
+    standard deviation σ (``<q>_sigma``: normal, taken as t = 3σ), not both;
+    it must apply to the follower (``offset`` to a slide, ``pivot_*`` and
+    ``arm_length`` or ``face_offset`` to an arm) and be smaller than the part
+    (t below the base radius, the roller radius, or 90° for the phase).
+
+    Raises
+    ------
+    DesignError
+        Naming the key (``tolerance.form_pm``), the value and what is allowed.
+    """
+    from camcad.geometry.sensitivity import applicable, mount_of  # only a study needs these (SciPy)
+    from camcad.inspect.spec import StudyMethod, ToleranceSpec
+    from camcad.inspect.tolerance import Distribution, Method, Tolerance
+
+    kw = _section("tolerance", table)
+    if "method" in kw:
+        kw["method"] = StudyMethod(kw["method"].value)
+    if "allocation" in kw:
+        kw["allocation"] = Method(kw["allocation"].value)
+    allowed = applicable(mount_of(Cam.from_design(design)))
+    tolerances: list[Tolerance] = []
+    keys: list[str] = []
+    for name, tol in _TOLERANCED.items():
+        given = [how for how in ("pm", "sigma") if f"{name}_{how}" in kw]
+        if not given:
+            continue
+        key = f"{name}_{given[-1]}"
+        if len(given) == 2:
+            raise DesignError(f"tolerance.{key}", f"{name}_pm is given too; allowed: one of the two")
+        if tol not in allowed:
+            names = ", ".join(f"{n}_pm" for n, t in _TOLERANCED.items() if t in allowed)
+            raise DesignError(
+                f"tolerance.{key}",
+                f"does not apply to a {design.follower.kind.value} follower; allowed: {names}",
+            )
+        value = kw[key] * (3.0 if given[0] == "sigma" else 1.0)  # a normal spread's ±t holds 99.73 %
+        limit, what = (
+            (90.0, "° (a quarter turn)")
+            if tol is Tol.PHASE
+            else (design.follower.roller_radius, " mm (the roller radius)")
+            if tol is Tol.ROLLER_RADIUS
+            else (design.cam.base_radius, " mm (the base radius)")
+        )
+        if value >= limit:
+            unit = "°" if tol is Tol.PHASE else " mm"
+            spread = f"3σ = {value:g}{unit}" if given[0] == "sigma" else f"±{value:g}{unit}"
+            raise DesignError(
+                f"tolerance.{key}", f"{spread} is larger than the part; allowed: below {limit:g}{what}"
+            )
+        distribution = Distribution.NORMAL if given[0] == "sigma" else Distribution.UNIFORM
+        scale = DEG if tol is Tol.PHASE else 1.0
+        tolerances.append(Tolerance(tol=tol, value=value * scale, distribution=distribution))
+        keys.append(f"tolerance.{key}")
+    if not tolerances:
+        raise DesignError(
+            "tolerance",
+            "names no toleranced quantity; allowed: "
+            + ", ".join(f"{n}_pm or {n}_sigma" for n, t in _TOLERANCED.items() if t in allowed),
+        )
+    extra = {
+        k: kw[k]
+        for k in ("samples", "seed", "method", "dwell_accuracy", "confidence", "allocation")
+        if k in kw
+    }
+    return ToleranceSpec(tolerances=tuple(tolerances), keys=tuple(keys), **extra)
 
 
 def load_design(path: str | Path, *, confine_to: Path | None = None) -> Design:

@@ -18,6 +18,7 @@ from camcad.dynamics.drive import DriveSpec
 from camcad.dynamics.film import LubricationSpec
 from camcad.dynamics.life import LifeSpec
 from camcad.dynamics.spec import DynamicsSetup, DynamicsSpec
+from camcad.dynamics.vibration.spec import VibrationSpec
 from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec
 from camcad.fit.spec import FitSpec
@@ -77,6 +78,7 @@ class Design:
     life: LifeSpec | None = None  # [life], [lubrication], [drive] (issue 35): None when absent
     lubrication: LubricationSpec | None = None
     drive: DriveSpec | None = None
+    vibration: VibrationSpec | None = None  # [vibration] (issue 34): None when absent
     source: str = ""
 
     def plate(self) -> Plate:

@@ -76,6 +76,11 @@ class ArmLoad:
     def _psi(self, motion: Motion) -> FloatArray:
         return np.asarray(motion.s, dtype=float) * _RAD_PER_DEG
 
+    @property
+    def unloaded(self) -> bool:
+        """Whether B ≡ 0 at every arm angle: no spring moment, no preload, no weight's moment."""
+        return self.spring_rate == 0.0 and self.preload == 0.0 and self.mass * self.cg_distance == 0.0
+
     def inertia_coefficient(self, motion: Motion) -> FloatArray:
         """A = I·ψ″/1000 [N·mm·s²]: the inertia moment per ω²."""
         out = self.inertia * np.asarray(motion.a, dtype=float) * _RAD_PER_DEG / MM_PER_M

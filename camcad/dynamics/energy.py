@@ -72,6 +72,11 @@ class FollowerLoad:
         """m·g [N] if gravity acts, else 0 (Hren et al., eq. 14)."""
         return self.mass * STANDARD_GRAVITY if self.gravity else 0.0
 
+    @property
+    def unloaded(self) -> bool:
+        """Whether B ≡ 0 at every angle: no weight, no spring rate, no preload."""
+        return self.weight == 0.0 and self.spring.rate == 0.0 and self.spring.preload == 0.0
+
     def inertia_coefficient(self, motion: Motion) -> FloatArray:
         """Return A = m·a/1000 [N·s²], the inertia force per ω² (Hren et al., eqs. 15-16).
 

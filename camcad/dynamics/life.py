@@ -214,7 +214,11 @@ def equivalent_load(force: ArrayLike, weight: ArrayLike, *, exponent: float) -> 
     total = float(np.sum(dn))
     if total <= 0.0:
         return 0.0
-    return float((np.dot(f**exponent, dn) / total) ** (1.0 / exponent))  # ISO 281 §7.2
+    top = float(f.max()) if f.size else 0.0
+    if top <= 0.0:
+        return 0.0
+    # ISO 281 §7.2, scaled by the largest load so that F^p neither underflows nor overflows
+    return top * float((np.dot((f / top) ** exponent, dn) / total) ** (1.0 / exponent))
 
 
 def roller_l10(rating: float, load: float, *, exponent: float) -> float:

@@ -27,7 +27,7 @@ from camcad.dynamics.spring import spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, tappet_forces
 from camcad.extremes import Extreme, Kind, Side, extremes_rows
 from camcad.findings import Finding, Severity
-from camcad.roots import brent_root
+from camcad.roots import brent_roots
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -40,6 +40,7 @@ _RAD_S_TO_RPM = 60.0 / (2.0 * math.pi)
 _KINDS: tuple[Kind, ...] = ("min", "max", "min", "max", "max", "max", "max", "min", "max")
 # a groove's further extremes: the load and the stress on each flank where it drives (inner, outer)
 _FLANK_KINDS: tuple[Kind, ...] = ("max", "max", "max", "max")
+_SPEED_BOUND_ROWS = (6, 7, 8)  # flat, upper, lower of speed_bounds (see _reported)
 # Warn when a guide force changes side and its misdirected friction exceeds this share of N1.
 _GUIDE_FLIP_RTOL = 0.01
 
@@ -281,7 +282,15 @@ def analyse_dynamics(
 
     grooved = setup.flank_offsets is not None
     found = _extremes(
-        model, sampled, phi, cam, margin=margin, omega=omega, preload=spring_preload, flanks=grooved
+        model,
+        sampled,
+        phi,
+        cam,
+        margin=margin,
+        omega=omega,
+        preload=spring_preload,
+        flanks=grooved,
+        unloaded=_load(setup).unloaded,
     )
     force_min, force_max, torque_min, torque_max, stress_max, need, flat_need, upper, lower = found[:9]
     flank_force = flank_stress = None
@@ -376,28 +385,43 @@ def _crossovers(
         return (), ()
     sign = force[live] > 0.0
     joints = np.sort(np.asarray([bp.phi for bp in cam.program.breakpoints])) if cam is not None else None
-    found: list[float] = []
-    speeds: list[float] = []
-    for k in np.flatnonzero(sign != np.roll(sign, -1)):
+    changes = np.flatnonzero(sign != np.roll(sign, -1))
+    roots: list[float] = []
+    brackets: list[tuple[int, float, float]] = []  # (which change, a, b) to refine on the exact model
+    for at, k in enumerate(changes):
         i, n = int(live[k]), int(live[(k + 1) % live.size])
         a, b = float(phi[i]), float(phi[n])
         if b <= a:
             b += TWO_PI
-        root = 0.5 * (a + b)
+        roots.append(0.5 * (a + b))
         rest = []  # the joints between the last sample of one sign and the first of the other
         if joints is not None and (n - i) % phi.size > 1:
             rest = [q for q in np.concatenate((joints, joints + TWO_PI)) if a < q <= b]
         if rest:  # across a rest: the new flank drives from the joint where the rest ends
-            root = float(max(rest))
+            roots[at] = float(max(rest))
         elif cam is not None:
+            brackets.append((at, a, b))
+    if brackets and cam is not None:
+        exact = cam
 
-            def f(p: float, exact: Cam = cam) -> float:
-                st = exact.state(np.array([p]))
-                return float(model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force[0])
+        def f(p: FloatArray) -> FloatArray:
+            st = exact.state(p)
+            return model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force
 
-            if f(a) * f(b) < 0.0:
-                root = brent_root(f, a, b, xtol=1e-12)
-        root %= TWO_PI
+        which = [at for at, _, _ in brackets]
+        a_s = np.array([a for _, a, _ in brackets])
+        b_s = np.array([b for _, _, b in brackets])
+        ends = f(np.concatenate((a_s, b_s)))  # both ends of every bracket in one evaluation
+        fa, fb = ends[: a_s.size], ends[a_s.size :]
+        crossed = fa * fb < 0.0  # else the midpoint stays
+        if crossed.any():
+            refined = brent_roots(f, a_s[crossed], b_s[crossed], fa=fa[crossed], fb=fb[crossed], xtol=1e-12)
+            for at, root in zip(np.asarray(which)[crossed].tolist(), refined.tolist(), strict=True):
+                roots[at] = root
+    found: list[float] = []
+    speeds: list[float] = []
+    for at, k in enumerate(changes):
+        root = roots[at] % TWO_PI
         found.append(root)
         if cam is not None and setup.clearance > 0.0:
             leaving = 1.0 if sign[k] else -1.0  # the flank it leaves drove it forwards (F > 0) or back
@@ -424,10 +448,14 @@ def _extremes(
     omega: float,
     preload: float,
     flanks: bool = False,
+    unloaded: bool = False,
 ) -> tuple[Extreme, ...]:
     """The true extremes of every reported quantity (``_KINDS``, then a groove's ``_FLANK_KINDS``).
 
-    Without a cam, the samples' extremes.
+    Without a cam, the samples' extremes. ``unloaded``: no spring and no
+    weight load the follower (B ≡ 0, a positively driven one, say); with a
+    zero margin the need margin·c − B of the speed bounds is then 0 wherever
+    it applies and ±inf elsewhere, so their sampled extremes are exact.
     """
     kinds = _KINDS + _FLANK_KINDS if flanks else _KINDS
 
@@ -449,7 +477,8 @@ def _extremes(
         return rows(model(st.motion, st.pressure_angle, st.profile.rho, st.lever))
 
     joints = [bp.phi for bp in cam.program.breakpoints]
-    return extremes_rows(quantity, phi, joints, kinds, values=values)
+    settled = [unloaded and margin == 0.0 and k in _SPEED_BOUND_ROWS for k in range(len(kinds))]
+    return extremes_rows(quantity, phi, joints, kinds, values=values, rests=cam.rests, settled=settled)
 
 
 def _findings(

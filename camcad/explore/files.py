@@ -33,8 +33,8 @@ def _header(problem: Problem, cand: Candidate, what: str) -> str:
         f"variables: {values}\nobjectives: {objectives}\nactive constraints: {active}"
     )
     if not cand.feasible:
-        broken = (
-            ", ".join(c.name for c in cand.constraints if c.margin < 0.0) or "the design cannot be analysed"
+        broken = ", ".join([c.name for c in cand.constraints if c.margin < 0.0] + list(cand.findings)) or (
+            "the design cannot be analysed"
         )
         text = (
             f"INFEASIBLE: no design within the ranges meets every limit; this one breaks: {broken}\n" + text

@@ -7,18 +7,31 @@ figures, see :mod:`camcad.extremes`), in the units of the report:
 name                      unit  figure
 ========================  ====  =================================================
 ``base_radius``           mm    ``cam.base_radius`` (the cam's size)
-``pressure_angle``        deg   peak \|α\| over the turn
-``contact_stress``        MPa   peak Hertz stress
+``pressure_angle``        deg   peak \|α\| over the turn, on every plate
+``contact_stress``        MPa   peak Hertz stress, on every plate and flank
 ``torque``                N·mm  peak \|input torque\|
-``contact_force``         N     peak contact force
+``contact_force``         N     peak contact force, on every plate and flank
 ``contact_force_min``     N     smallest contact force (follower jump below 0)
-``curvature_radius``      mm    smallest convex profile radius
+``curvature_radius``      mm    smallest convex profile radius, on every plate
 ``roller_life_h``         h     track roller's L10 life (``[life]``; issue 35)
 ``min_film_ratio``        1     smallest film ratio λ (``[lubrication]``)
 ``motor_rms_torque``      N·m   motor's RMS torque (``[drive]``)
+``vibration_residual_mm`` mm    largest residual vibration in a dwell at the
+                                design speed (``[vibration]``; issue 34;
+                                degrees of swing on an arm)
+``min_dynamic_contact_``  N     smallest contact force of the elastic train at
+``force``                       the design speed (``[vibration]``; N·mm on an arm)
 ========================  ====  =================================================
 
-The last three are empty (None) for a design without their table.
+The last five are empty (None) for a design without their table.
+
+Every part is held to a limit (issue 31): a conjugate pair's figures are the
+worse of its two plates' (the second plate with its own roller, the
+``second_plate`` section of ``summary.json``), a groove's the worse of its
+two flanks' where each drives (``dynamics.flanks``: the outer flank's load is
+the negative contact force's size). ``contact_force_min`` stays the signed
+figure of the first plate (positive where the first roller or the inner
+flank drives): a positive drive has no jump to keep.
 
 A limit is ``name<=value`` or ``name>=value`` in those units (``--limit
 contact_stress<=800``).
@@ -70,18 +83,66 @@ def _torque(summary: Mapping[str, Any]) -> float | None:
     return max(values) if values else None
 
 
+def _residual(summary: Mapping[str, Any]) -> float | None:
+    """The largest residual vibration over the dwells at the design speed [mm, or deg on an arm]."""
+    vib = summary.get("vibration")
+    if vib is None:
+        return None
+    values = vib.get("residual_mm", vib.get("residual_deg", []))
+    return max(values) if values else None
+
+
+def _sections(summary: Mapping[str, Any], name: str) -> list[Mapping[str, Any]]:
+    """The ``geometry`` or ``dynamics`` section of every plate: the first's, a conjugate pair's second's."""
+    out = [summary[name]]
+    second = summary.get("second_plate")
+    if second is not None and name in second:
+        out.append(second[name])
+    return out
+
+
+def _worst(values: Sequence[Any], pick: Callable[[Sequence[float]], float]) -> float | None:
+    known = [float(v) for v in values if v is not None]
+    return pick(known) if known else None
+
+
+def _per_part(summary: Mapping[str, Any], key: str) -> list[Any]:
+    """``key`` of every plate's dynamics and of each flank of a groove where it drives."""
+    out = [dyn.get(key) for dyn in _sections(summary, "dynamics")]
+    for flank in summary["dynamics"].get("flanks", {}).values():
+        out.append(flank.get(key))  # None where the flank never drives
+    return out
+
+
+def _contact_force(summary: Mapping[str, Any]) -> float | None:
+    """The largest load any part carries [N]: a groove's flanks' (each positive where it drives)."""
+    flanks = summary["dynamics"].get("flanks")
+    if flanks is not None:
+        found = _worst([f.get("contact_force_max_N") for f in flanks.values()], max)
+        if found is not None:
+            return found
+    return _worst([dyn.get("contact_force_max_N") for dyn in _sections(summary, "dynamics")], max)
+
+
 _FIGURES: dict[str, Callable[[Analysis, Mapping[str, Any]], float | None]] = {
     "base_radius": lambda a, s: a.design.cam.base_radius,
-    "pressure_angle": lambda a, s: s["geometry"]["pressure_angle_max_deg"],
-    "contact_stress": lambda a, s: s["dynamics"].get("hertz_stress_max_MPa"),
+    "pressure_angle": lambda a, s: _worst(
+        [g["pressure_angle_max_deg"] for g in _sections(s, "geometry")], max
+    ),
+    "contact_stress": lambda a, s: _worst(_per_part(s, "hertz_stress_max_MPa"), max),
     "torque": lambda a, s: _torque(s),
-    "contact_force": lambda a, s: s["dynamics"].get("contact_force_max_N"),
+    "contact_force": lambda a, s: _contact_force(s),
     "contact_force_min": lambda a, s: s["dynamics"].get("contact_force_min_N"),
-    "curvature_radius": lambda a, s: s["geometry"]["curvature_radius_min_mm"],
+    "curvature_radius": lambda a, s: _worst(
+        [g["curvature_radius_min_mm"] for g in _sections(s, "geometry")], min
+    ),
     # issue 35: life, film and drive, when the design has their tables
     "roller_life_h": lambda a, s: s.get("life", {}).get("roller_life_h"),
     "min_film_ratio": lambda a, s: s.get("lubrication", {}).get("min_film_ratio"),
     "motor_rms_torque": lambda a, s: s.get("drive", {}).get("motor_rms_torque_Nm"),
+    # issue 34: the elastic follower train at the design speed, when the design has [vibration]
+    "vibration_residual_mm": lambda a, s: _residual(s),
+    "min_dynamic_contact_force": lambda a, s: s.get("vibration", {}).get("contact_force_min"),
 }
 
 MEASURES: dict[str, Measure] = {
@@ -106,6 +167,18 @@ MEASURES: dict[str, Measure] = {
             name="min_film_ratio", unit="1", column="min_film_ratio", text="smallest lubricant film ratio"
         ),
         Measure(name="motor_rms_torque", unit="N·m", column="motor_rms_torque_Nm", text="motor RMS torque"),
+        Measure(
+            name="vibration_residual_mm",
+            unit="mm",
+            column="vibration_residual_mm",
+            text="largest residual vibration in a dwell",
+        ),
+        Measure(
+            name="min_dynamic_contact_force",
+            unit="N",
+            column="min_dynamic_contact_force_N",
+            text="smallest contact force of the elastic train",
+        ),
     )
 }
 """The objectives and limit quantities by name."""

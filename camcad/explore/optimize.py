@@ -9,7 +9,9 @@ curvature and contact stress):
     over       x in [low, high]       the continuous variables (``--vary name=low:high``)
                and every combination of the discrete ones (``--vary law=a,b``), by enumeration
     subject to the limits             ``--limit`` and the design's own (``max_pressure_angle``,
-                                      ``allowable_stress``), and no undercut (always)
+                                      ``allowable_stress``, ``min_contact_force`` for a follower
+                                      held on by a spring), the curvature limit
+                                      (``min_curvature_radius``; no undercut or cusp, always)
 
 Every function value comes from a full analysis of the variant
 (:func:`camcad.pipeline.analyse`, no fit, no toolpath), so the constraints are
@@ -21,10 +23,20 @@ smooth constraints, max α ≤ A and −min α ≤ A: at the smallest cam both
 usually hold with equality at once (the rise and the return), a corner that
 the single constraint max |α| ≤ A would hide from a gradient method.
 
-Constraints are met with a small reserve (:data:`RESERVE`, relative), so the
-design file of the optimum passes ``camcad check`` and not only the
-solver's tolerance. A candidate is feasible when every limit holds as
-``camcad check`` judges it (margin ≥ 0). The optimum's values are given with
+The limits are those of ``camcad check`` and ``camcad size``, one set
+(issue 31): every plate of a conjugate pair and every flank of a groove is
+held to them (:mod:`camcad.explore.measures`,
+:func:`camcad.geometry.sizing.feasible_margins`), the curvature limit is
+:func:`camcad.geometry.sizing.meets_curvature`, and a ``--limit`` that
+replaces one of the design's own is written into every variant's design
+file (``cam.max_pressure_angle``, ``dynamics.allowable_stress``,
+``dynamics.min_contact_force``), so ``camcad check`` on the optimum's file
+judges by it. Constraints are met with a small reserve (:data:`RESERVE`,
+relative), so the design file of the optimum passes ``camcad check`` and not
+only the solver's tolerance. A candidate is feasible when every constraint
+holds (margin ≥ 0) and the analysis finds no broken limit (``camcad
+check``'s verdict, without its fit and FE stages: a design with ``[fea]``
+or a tight ``fit.tolerance`` is judged on them only by ``check``). The optimum's values are given with
 the fewest significant digits (6 to 17) at which the design, analysed again,
 is still feasible: the values printed, written to ``optimum.toml`` and typed
 back all give the same passing design. A constraint is reported *active* when its margin is
@@ -41,7 +53,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -63,6 +75,7 @@ __all__ = [
     "OptimizeResult",
     "Problem",
     "design_limits",
+    "limits_data",
     "optimize",
 ]
 
@@ -172,12 +185,23 @@ class OptimizeResult:
         }
 
 
+# the design-file key holding each of the design's own limits (quantity, direction)
+_OWN_KEYS: dict[tuple[str, str], tuple[str, str]] = {
+    ("pressure_angle", "<="): ("cam", "max_pressure_angle"),
+    ("contact_stress", "<="): ("dynamics", "allowable_stress"),
+    ("contact_force_min", ">="): ("dynamics", "min_contact_force"),
+}
+
+
 def design_limits(data: Mapping[str, Any], limits: Sequence[Limit], *, source: str = "") -> tuple[Limit, ...]:
     """The limits an optimisation keeps: the design's own, replaced or joined by ``limits``.
 
-    The design's own are ``pressure_angle <= cam.max_pressure_angle`` and,
-    when ``dynamics.allowable_stress`` is given, ``contact_stress <= it``; a
-    ``--limit`` on the same quantity and direction replaces it.
+    The design's own are ``pressure_angle <= cam.max_pressure_angle``,
+    ``contact_stress <= dynamics.allowable_stress`` when it is given, and
+    ``contact_force_min >= dynamics.min_contact_force`` for a follower held on
+    by a spring (a positive drive has no jump); a ``--limit`` on the same
+    quantity and direction replaces it (:func:`limits_data` writes it into
+    the design file).
     """
     design = design_with(data, (), (), source=source)
     own = [
@@ -185,8 +209,44 @@ def design_limits(data: Mapping[str, Any], limits: Sequence[Limit], *, source: s
     ]
     if design.dynamics.allowable_stress is not None:
         own.append(Limit(measure=MEASURES["contact_stress"], op="<=", value=design.dynamics.allowable_stress))
+    if not design.dynamics_setup().positive_drive:
+        own.append(
+            Limit(measure=MEASURES["contact_force_min"], op=">=", value=design.dynamics.min_contact_force)
+        )
     given = {(lim.measure.name, lim.op) for lim in limits}
     return tuple([lim for lim in own if (lim.measure.name, lim.op) not in given] + list(limits))
+
+
+def limits_data(data: Mapping[str, Any], limits: Sequence[Limit], *, source: str = "") -> dict[str, Any]:
+    """The design mapping with each ``--limit`` that replaces one of the design's own written in.
+
+    ``pressure_angle<=40`` sets ``cam.max_pressure_angle = 40``,
+    ``contact_stress<=800`` ``dynamics.allowable_stress = 800``,
+    ``contact_force_min>=5`` ``dynamics.min_contact_force = 5`` (the last
+    only for a follower held on by a spring): the design file of the optimum
+    then carries the limits it was found under, and ``camcad check`` judges
+    it by them.
+
+    Raises
+    ------
+    UsageError
+        Naming ``--limit`` when the design file does not accept the value there.
+    """
+    out: dict[str, Any] = {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in data.items()}
+    positive = design_with(data, (), (), source=source).dynamics_setup().positive_drive
+    for lim in limits:
+        place = _OWN_KEYS.get((lim.measure.name, lim.op))
+        if place is None or (positive and lim.measure.name == "contact_force_min"):
+            continue
+        table, key = place
+        out.setdefault(table, {})[key] = lim.value
+        try:
+            design_with(out, (), (), source=source)
+        except CamcadError as err:
+            raise UsageError(
+                "--limit", f"{lim.text}: it replaces {table}.{key}, and the design file refuses it: {err}"
+            ) from None
+    return out
 
 
 # The measures that are the larger of two smooth pieces, and the pieces' names: a limit ``≤`` on
@@ -227,7 +287,7 @@ def _constraint_names(limits: Sequence[Limit]) -> list[str]:
             names += [f"{lim.text} ({piece})" for piece in _PIECES[lim.measure.name]]
         else:
             names.append(lim.text)
-    return [*names, "no undercut: convex radius − required ≥ 0 mm"]
+    return [*names, "curvature: convex ρ − required ≥ 0 mm"]
 
 
 def _constraints(point: _Point, limits: Sequence[Limit]) -> tuple[list[float | None], np.ndarray]:
@@ -299,33 +359,40 @@ class _Evaluator:
             return _Point({}, {}, -math.inf, 1.0, (str(err),), False)
         summary = analysis.summary()
         measures = measure_values(analysis, summary)
-        hi, lo = _signed_pressure_deg(analysis)
-        pieces: dict[str, tuple[float, ...]] = {"pressure_angle": (hi, -lo)}
+        plates = [(r.part.cam, r.geometry.phi) for r in analysis.parts]  # every part: a pair's second plate
+        signed = [_signed_pressure_deg(cam, phi) for cam, phi in plates]
+        pieces: dict[str, tuple[float, ...]] = {
+            "pressure_angle": (max(hi for hi, _ in signed), -min(lo for _, lo in signed))
+        }
         t_max, t_min = summary["dynamics"].get("torque_max_Nmm"), summary["dynamics"].get("torque_min_Nmm")
         if t_max is not None and t_min is not None:
             pieces["torque"] = (float(t_max), -float(t_min))
+        # the curvature limit of check and size, on every plate (camcad.geometry.sizing.meets_curvature)
         _, rho_margin, _, _ = feasible_margins(
             analysis.cam,
             analysis.geometry.phi,
             max_pressure_angle=math.pi / 2,
             min_curvature_radius=design.min_curvature_radius,
+            conjugate=None if drive.partner is None else drive.partner.conjugate,
         )
+        if drive.groove is not None:  # a groove's flanks loop where their radius reaches 0 (a hard limit)
+            flanks = (drive.groove.inner_convex_min, drive.groove.outer_concave_min)
+            rho_margin = min([rho_margin, *(f.value for f in flanks if f is not None)])
         findings = tuple(f.message for f in analysis.findings)
         return _Point(measures, pieces, float(rho_margin), max(design.cam.base_radius, 1.0), findings, True)
 
 
-def _signed_pressure_deg(analysis: Any) -> tuple[float, float]:
+def _signed_pressure_deg(cam: Any, phi: np.ndarray) -> tuple[float, float]:
     """The true max and min of the signed pressure angle over the turn [deg] (one-sided at joints)."""
     from camcad.extremes import extremes_rows
 
-    cam = analysis.cam
     joints = [bp.phi for bp in cam.program.breakpoints]
 
     def rows(p: np.ndarray, side: Any) -> np.ndarray:
         alpha = cam.state(p, side=side).pressure_angle
         return np.vstack((alpha, alpha))
 
-    hi, lo = extremes_rows(rows, analysis.geometry.phi, joints, ("max", "min"))
+    hi, lo = extremes_rows(rows, phi, joints, ("max", "min"))
     return math.degrees(hi.value), math.degrees(lo.value)
 
 
@@ -439,7 +506,8 @@ def _candidate(
         measures=dict(point.measures),
         constraints=tuple(states),
         bounds=tuple(bounds),
-        feasible=point.valid and bool(np.all(margins >= 0.0)),  # every limit holds, as `camcad check` judges
+        # every limit holds and the analysis found none broken: `camcad check`'s verdict
+        feasible=point.valid and bool(np.all(margins >= 0.0)) and not point.findings,
         data=apply_values(ev.problem.data, variables, values),
         evaluations=len(ev.cache),
         message=message,
@@ -566,6 +634,7 @@ def optimize(problem: Problem, *, progress: Callable[[str], None] | None = None)
     if not 0 <= problem.seed <= 2**32 - 1:
         raise UsageError("--seed", f"{problem.seed} is not allowed (allowed: 0 to {2**32 - 1})")
     limits = design_limits(problem.data, problem.limits, source=problem.source)
+    problem = replace(problem, data=limits_data(problem.data, problem.limits, source=problem.source))
     discrete = [v for v in problem.variables if not v.continuous]
     count = math.prod(len(v.choices or ()) for v in discrete)
     if count > MAX_COMBINATIONS:

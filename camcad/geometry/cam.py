@@ -11,11 +11,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
+from camcad.angles import TWO_PI
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import (
     LineElement,
@@ -36,7 +37,7 @@ from camcad.geometry.followers import (
 from camcad.geometry.followers.tied import TiedRoller
 from camcad.geometry.spec import ConjugateSpec, FollowerKind, FollowerSpec, Rotation
 from camcad.motion.program import Motion, MotionProgram, Side
-from camcad.motion.segments import SegmentSpec
+from camcad.motion.segments import SegmentKind, SegmentSpec
 
 __all__ = ["Cam", "CamState", "follower_from_spec"]
 
@@ -157,7 +158,7 @@ class Cam:
     rotation: Rotation = Rotation.CCW
     sample_step: float = math.radians(0.1)
     conjugate: ConjugateSpec | None = None  # set: this is the pair's second plate, driving the tied roller
-    _memo: dict[str, Follower] = field(  # the follower module, built once (see kinematics)
+    _memo: dict[str, Any] = field(  # the follower module, and the last sample grid's motion and state
         default_factory=dict, init=False, compare=False, hash=False, repr=False
     )
 
@@ -182,7 +183,8 @@ class Cam:
         """
         if "kinematics" not in self._memo:
             self._memo["kinematics"] = self._follower()
-        return self._memo["kinematics"]
+        out: Follower = self._memo["kinematics"]
+        return out
 
     def _follower(self) -> Follower:
         first = follower_from_spec(self.follower, self.base_radius)
@@ -198,8 +200,16 @@ class Cam:
         )
 
     def partner(self, conjugate: ConjugateSpec) -> Cam:
-        """The conjugate pair's second plate, on the same shaft, driving the tied second roller."""
-        return replace(self, conjugate=conjugate)
+        """The conjugate pair's second plate, on the same shaft, driving the tied second roller.
+
+        Both plates follow one motion program: the second starts with the
+        first one's motion of the sample grid, if computed, instead of
+        evaluating it again.
+        """
+        out = replace(self, conjugate=conjugate)
+        if "motion" in self._memo:
+            out._memo["motion"] = self._memo["motion"]
+        return out
 
     @property
     def is_roller(self) -> bool:
@@ -222,8 +232,39 @@ class Cam:
         return 1.0 if self.rotation is Rotation.CCW else -1.0
 
     def motion(self, phi: ArrayLike, *, side: Side = "right") -> Motion:
-        """The follower motion at cam angles φ [rad]; ``side`` picks the one-sided limit at joints."""
-        return self.program.evaluate(phi, side=side)
+        """The follower motion at cam angles φ [rad]; ``side`` picks the one-sided limit at joints.
+
+        The motion of the last sample grid asked for (:data:`_GRID_MIN` angles
+        or more) is kept and given again for the same angles and side: every
+        stage of an analysis samples the cam on one grid.
+        """
+        key = _grid_key(phi, side)
+        if key is not None:
+            kept = self._memo.get("motion")
+            if kept is not None and kept[0] == key:
+                out: Motion = kept[1]
+                return out
+        m = self.program.evaluate(phi, side=side)
+        if key is not None:
+            self._memo["motion"] = (key, m)
+        return m
+
+    @property
+    def rests(self) -> tuple[tuple[float, float], ...]:
+        """The dwells, each as [start, end] [rad]: the follower stands still, every quantity is constant.
+
+        On a dwell the profile is an arc about the cam axis and the follower's
+        state does not change (s constant, v = a = j = 0 exactly): the true
+        extremes searches (:func:`camcad.extremes.extremes_rows`) need not
+        refine there.
+        """
+        program = self.program
+        ends = (*program.starts[1:], TWO_PI)
+        return tuple(
+            (start, end)
+            for start, end, seg in zip(program.starts, ends, program.segments, strict=True)
+            if seg.kind is SegmentKind.DWELL or seg.law is None
+        )
 
     def sample_phi(self, step: float | None = None) -> FloatArray:
         """Cam angles in [0, 2π) at ``step`` [rad] (default: the design's) plus every breakpoint."""
@@ -285,7 +326,20 @@ class Cam:
 
         The analyses refine many quantities at once on the same angles; this
         computes the contact element and its envelope once for all of them.
+        The state of the last sample grid asked for is kept, as in :meth:`motion`.
         """
+        key = _grid_key(phi, side)
+        if key is not None:
+            kept = self._memo.get("state")
+            if kept is not None and kept[0] == key:
+                got: CamState = kept[1]
+                return got
+        out = self._state(phi, side)
+        if key is not None:
+            self._memo["state"] = (key, out)
+        return out
+
+    def _state(self, phi: ArrayLike, side: Side) -> CamState:
         m, element = self._element(phi, side)
         if isinstance(element, PointElement):
             base, drho = point_envelope(m.phi, element, self.sigma)
@@ -303,13 +357,16 @@ class Cam:
         if guide.pivot is not None:
             arm = driven_machine - np.asarray(guide.pivot)
             lever = np.hypot(arm[:, 0], arm[:, 1])
+            readonly(lever)
+        position = self.kinematics.contact_position(contact, m)
+        readonly(position)
         return CamState(
             lever=lever,
             motion=m,
             base=base,
             profile=profile,
             pressure_angle=alpha,
-            contact_position=self.kinematics.contact_position(contact, m),
+            contact_position=position,
         )
 
     def loop_radius(self, state: CamState) -> FloatArray:
@@ -353,3 +410,14 @@ class Cam:
         out = self.kinematics.contact_position(contact, m)
         readonly(out)
         return out
+
+
+_GRID_MIN = 256
+"""The fewest angles a sample grid has: smaller requests (a refinement's few points) are not kept."""
+
+
+def _grid_key(phi: ArrayLike, side: Side) -> tuple[Side, int, bytes] | None:
+    """What identifies a sample grid of :data:`_GRID_MIN` or more angles [rad]; None for fewer."""
+    if not isinstance(phi, np.ndarray) or phi.size < _GRID_MIN:
+        return None
+    return side, phi.size, np.ascontiguousarray(phi, dtype=float).tobytes()

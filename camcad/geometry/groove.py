@@ -142,7 +142,9 @@ def analyse_groove(
         near = np.hypot(*(base - half * normal).T)
         return np.vstack((convex - half, concave - half, inner_tool, outer_tool, reach, near))
 
-    inner, outer, inner_tool, outer_tool, reach, near = extremes_rows(rows, phi, joints, kinds)
+    inner, outer, inner_tool, outer_tool, reach, near = extremes_rows(
+        rows, phi, joints, kinds, rests=cam.rests
+    )
     findings: list[Finding] = []
     if outer_radius is not None and reach.value >= outer_radius:
         findings.append(

@@ -13,11 +13,11 @@ from camcad.angles import TWO_PI, flagged_ranges, format_ranges
 from camcad.errors import UndercutError
 from camcad.extremes import SIDE_WORDS, Extreme, Kind, Quantity, Side, extremes_rows
 from camcad.findings import Finding, Severity
-from camcad.geometry.cam import Cam
+from camcad.geometry.cam import Cam, CamState
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import LineElement, PointElement
 from camcad.geometry.followers.tied import TiedRoller
-from camcad.geometry.sizing import min_base_radius
+from camcad.geometry.sizing import curvature_finding, min_base_radius
 from camcad.roots import brent_root
 
 __all__ = ["GeometryAnalysis", "Undercut", "analyse_geometry", "conjugate_overlap", "undercut_error"]
@@ -262,7 +262,11 @@ def analyse_geometry(
     face_margin
         Margin [mm] beyond the contact's travel at each edge of the face.
     min_curvature_radius
-        Smallest convex profile radius [mm] the undercut advice sizes for.
+        Smallest convex profile radius [mm] the design requires
+        (``cam.min_curvature_radius``): above 0 and below it is a soft
+        finding (:func:`camcad.geometry.sizing.curvature_finding`, the rule
+        ``camcad size`` and ``camcad optimize`` use too); the undercut advice
+        sizes for it.
     step
         Sampling step [rad]; default the cam's (0.1°). Breakpoints are always
         samples, and every extreme is refined on the exact curves between
@@ -281,8 +285,10 @@ def analyse_geometry(
     kinds: tuple[Kind, ...] = ("max", "min", "max", "min", "min", "min", "min", "max")
 
     def rows(p: FloatArray, side: Side) -> FloatArray:
+        return rows_of(cam.state(p, side=side))
+
+    def rows_of(st: CamState) -> FloatArray:
         """|α|, profile radius (min, max), convex ρ, concave ρ, undercut quantity, contact x (min, max)."""
-        st = cam.state(p, side=side)
         radius = np.hypot(st.profile.point[:, 0], st.profile.point[:, 1])
         rho = st.profile.rho
         undercut = cam.loop_radius(st)
@@ -292,9 +298,9 @@ def analyse_geometry(
         concave = np.where(np.isfinite(undercut), np.inf, _concave(rho))
         return np.vstack((np.abs(st.pressure_angle), radius, radius, convex, concave, undercut, x, x))
 
-    values = rows(phi, "right")
+    values = rows_of(now)  # the samples: the state above, not a second evaluation
     alpha_max, radius_min, radius_max, convex_min, concave_min, worst, reach_min, reach_max = extremes_rows(
-        rows, phi, joints, kinds, values=values
+        rows, phi, joints, kinds, values=values, rests=cam.rests
     )
 
     if alpha_max.value > max_pressure_angle:
@@ -338,7 +344,10 @@ def analyse_geometry(
         concave_radius_min=concave_min if math.isfinite(concave_min.value) else None,
     )
     if undercut is None:
-        return analysis
+        # the design's own smallest radius (0 < ρ_min < required): the one rule of check, size and optimize
+        rho = replace(worst, value=worst.value - limit)  # convex profile radius (a roller's: pitch ρ − r_f)
+        soft = curvature_finding(cam, rho, required=min_curvature_radius)
+        return analysis if soft is None else replace(analysis, findings=(*analysis.findings, soft))
     err = undercut_error(analysis, min_curvature_radius=min_curvature_radius)
     undercut_finding = Finding(
         kind="undercut" if cam.is_roller else "cusp",

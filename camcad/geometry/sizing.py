@@ -1,4 +1,15 @@
-"""Smallest base radius that meets the pressure-angle and curvature limits."""
+"""Smallest base radius that meets the pressure-angle and curvature limits, and the curvature limit itself.
+
+The curvature limit is one rule, applied here for ``camcad size``, by
+:func:`camcad.geometry.limits.analyse_geometry` for ``camcad check`` (through
+:func:`curvature_finding`) and by ``camcad optimize`` (through
+:func:`feasible_margins`): the smallest convex profile radius ρ_min [mm] must
+be at least ``cam.min_curvature_radius`` (default 0 for a roller, 1 mm for a
+flat face), and above 0 when that is 0 (:func:`meets_curvature`). ρ_min ≤ 0
+is an undercut or a cusp, a hard limit; 0 < ρ_min < the required radius is a
+soft one (engineering judgement, like the pressure angle). A conjugate pair
+is held to both limits on both plates (``conjugate``).
+"""
 
 from __future__ import annotations
 
@@ -10,10 +21,18 @@ import numpy as np
 from camcad._typing import FloatArray
 from camcad.errors import DesignError
 from camcad.extremes import Extreme, Side, extremes_rows
+from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
-from camcad.geometry.spec import arm_problem
+from camcad.geometry.spec import ConjugateSpec, arm_problem
 
-__all__ = ["SizingResult", "feasible_margins", "min_base_radius", "min_pivot_distance"]
+__all__ = [
+    "SizingResult",
+    "curvature_finding",
+    "feasible_margins",
+    "meets_curvature",
+    "min_base_radius",
+    "min_pivot_distance",
+]
 
 _RADIUS_TOL_MM = 1e-7
 _MAX_RADIUS_MM = 1e5
@@ -38,8 +57,55 @@ class SizingResult:
     pivot_distance: float | None = None  # mm, oscillating followers: d at the result
 
 
+def meets_curvature(rho_min: float, required: float) -> bool:
+    """The curvature limit of every command: ρ_min ≥ ``required`` [mm], and ρ_min > 0 when it is 0.
+
+    ``rho_min`` is the smallest convex profile radius [mm] (negative in a
+    loop or cusp); a zero radius is a cusp, so with ``required`` 0 it must be
+    strictly positive.
+    """
+    return rho_min > 0.0 if required == 0.0 else rho_min >= required
+
+
+def curvature_finding(cam: Cam, worst: Extreme, *, required: float) -> Finding | None:
+    """The soft finding for a smallest convex radius ``worst`` [mm] above 0 but below ``required`` [mm].
+
+    None when the limit holds (:func:`meets_curvature`), when ``required`` is 0
+    (then only the undercut or cusp applies, a hard limit found by
+    :func:`~camcad.geometry.limits.analyse_geometry`) or when ``worst`` is not
+    above 0 (that hard limit). The message names the smallest base radius
+    that meets the limit (rounded up to 0.01 mm), as ``camcad size`` finds it.
+    """
+    if required == 0.0 or worst.value <= 0.0 or meets_curvature(worst.value, required):
+        return None
+    try:
+        sized = min_base_radius(cam, min_curvature_radius=required)
+        up = math.ceil(sized.base_radius * 100.0) / 100.0  # advice errs to the safe side
+        fix = f"use base_radius ≥ {up:.2f} mm (now {cam.base_radius:g} mm)"
+    except DesignError:
+        fix = "use a gentler motion law"
+    return Finding(
+        kind="curvature",
+        severity=Severity.SOFT,
+        field="cam.min_curvature_radius",
+        message=(
+            f"cam.min_curvature_radius: the convex profile radius of curvature falls to {worst.value:.3f} mm "
+            f"{worst.where()}, below the required {required:g} mm; {fix}, or lower the limit"
+        ),
+        angle=worst.phi,
+        value=worst.value,
+        limit=required,
+        unit="mm",
+    )
+
+
 def feasible_margins(
-    cam: Cam, phi: np.ndarray, *, max_pressure_angle: float, min_curvature_radius: float
+    cam: Cam,
+    phi: np.ndarray,
+    *,
+    max_pressure_angle: float,
+    min_curvature_radius: float,
+    conjugate: ConjugateSpec | None = None,
 ) -> tuple[float, float, Extreme, Extreme]:
     """Margins of both limits (≥ 0 is met) at their true extremes, and those extremes.
 
@@ -48,26 +114,33 @@ def feasible_margins(
     required one; a roller whose pitch curve is sharper than the roller (an
     undercut) has a negative margin. Both extremes are true extremes over the
     turn (:func:`camcad.extremes.extremes`): refined between the samples
-    ``phi`` [rad] and taken at both sides of every joint.
+    ``phi`` [rad] and taken at both sides of every joint. With ``conjugate``
+    (a conjugate pair's second roller) each margin is the smaller of the two
+    plates', and each extreme the binding plate's.
     """
     joints = [bp.phi for bp in cam.program.breakpoints]
+    plates = [cam] if conjugate is None or conjugate.single_plate else [cam, cam.partner(conjugate)]
+    found: list[tuple[Extreme, Extreme]] = []
+    for plate in plates:
 
-    def rows(p: FloatArray, side: Side) -> FloatArray:
-        """|α| and the convex profile radius (for a roller: convex pitch ρ − r_f)."""
-        st = cam.state(p, side=side)
-        return np.vstack((np.abs(st.pressure_angle), cam.loop_radius(st) - cam.roller_radius))
+        def rows(p: FloatArray, side: Side, plate: Cam = plate) -> FloatArray:
+            """|α| and the convex profile radius (for a roller: convex pitch ρ − r_f)."""
+            st = plate.state(p, side=side)
+            return np.vstack((np.abs(st.pressure_angle), plate.loop_radius(st) - plate.roller_radius))
 
-    worst_alpha, worst_rho = extremes_rows(rows, phi, joints, ("max", "min"))
+        worst_alpha, worst_rho = extremes_rows(rows, phi, joints, ("max", "min"))
+        found.append((worst_alpha, worst_rho))
+    worst_alpha = max((a for a, _ in found), key=lambda e: e.value)
+    worst_rho = min((r for _, r in found), key=lambda e: e.value)
     margin_rho = worst_rho.value - min_curvature_radius
     return max_pressure_angle - worst_alpha.value, margin_rho, worst_alpha, worst_rho
 
 
-def _ok(cam: Cam, phi: np.ndarray, alpha_max: float, rho_min: float) -> bool:
-    m_alpha, m_rho, _, _ = feasible_margins(
-        cam, phi, max_pressure_angle=alpha_max, min_curvature_radius=rho_min
+def _ok(cam: Cam, phi: np.ndarray, alpha_max: float, rho_min: float, conjugate: ConjugateSpec | None) -> bool:
+    m_alpha, _, _, worst_rho = feasible_margins(
+        cam, phi, max_pressure_angle=alpha_max, min_curvature_radius=rho_min, conjugate=conjugate
     )
-    # a zero convex radius is a cusp: strictly positive is required
-    return m_alpha >= 0.0 and (m_rho > 0.0 if rho_min == 0.0 else m_rho >= 0.0)
+    return m_alpha >= 0.0 and meets_curvature(worst_rho.value, rho_min)
 
 
 def min_base_radius(
@@ -76,6 +149,7 @@ def min_base_radius(
     max_pressure_angle: float = math.pi / 2,
     min_curvature_radius: float = 0.0,
     step: float | None = None,
+    conjugate: ConjugateSpec | None = None,
 ) -> SizingResult:
     """Search the smallest base radius [mm] meeting both limits at their true extremes.
 
@@ -90,6 +164,9 @@ def min_base_radius(
         only "no undercut / no cusp".
     step
         Sampling step [rad]; default the cam's.
+    conjugate
+        A conjugate pair's second roller: both plates must meet both limits
+        (the second plate's radii follow the first's base radius).
 
     Notes
     -----
@@ -104,14 +181,14 @@ def min_base_radius(
     """
     phi = cam.sample_phi(step)
     if cam.follower.kind.oscillating:
-        return _arm_search(cam, phi, "base_radius", max_pressure_angle, min_curvature_radius)
+        return _arm_search(cam, phi, "base_radius", max_pressure_angle, min_curvature_radius, conjugate)
     lo = max(abs(cam.eccentricity) - cam.roller_radius, 0.0) + _RADIUS_TOL_MM
 
     def at(radius: float) -> Cam:
         return replace(cam, base_radius=radius)
 
     hi = max(cam.base_radius, 1.0)
-    while not _ok(at(hi), phi, max_pressure_angle, min_curvature_radius):
+    while not _ok(at(hi), phi, max_pressure_angle, min_curvature_radius, conjugate):
         lo = hi
         hi *= 2.0
         if hi > _MAX_RADIUS_MM:
@@ -121,15 +198,19 @@ def min_base_radius(
                 f"(max pressure angle {math.degrees(max_pressure_angle):g}°, "
                 f"min curvature radius {min_curvature_radius:g} mm)",
             )
-    if _ok(at(lo), phi, max_pressure_angle, min_curvature_radius):
+    if _ok(at(lo), phi, max_pressure_angle, min_curvature_radius, conjugate):
         hi = lo
 
     def trial(radius: float) -> tuple[bool, float]:
         """Whether ``radius`` meets both limits, and its smaller relative margin."""
-        m_a, m_r, _, _ = feasible_margins(
-            at(radius), phi, max_pressure_angle=max_pressure_angle, min_curvature_radius=min_curvature_radius
+        m_a, m_r, _, worst = feasible_margins(
+            at(radius),
+            phi,
+            max_pressure_angle=max_pressure_angle,
+            min_curvature_radius=min_curvature_radius,
+            conjugate=conjugate,
         )
-        ok = m_a >= 0.0 and (m_r > 0.0 if min_curvature_radius == 0.0 else m_r >= 0.0)  # ρ = 0: a cusp
+        ok = m_a >= 0.0 and meets_curvature(worst.value, min_curvature_radius)
         return ok, min(m_a / max(max_pressure_angle, 1e-12), m_r / max(min_curvature_radius, 1.0))
 
     # Illinois regula falsi on the (continuous, increasing) relative margin, keeping the
@@ -148,7 +229,11 @@ def min_base_radius(
             f_hi, kept = (0.5 * f_hi if kept > 0 else f_hi), max(kept, 0) + 1
     best = at(hi)
     m_alpha, m_rho, worst_alpha, worst_rho = feasible_margins(
-        best, phi, max_pressure_angle=max_pressure_angle, min_curvature_radius=min_curvature_radius
+        best,
+        phi,
+        max_pressure_angle=max_pressure_angle,
+        min_curvature_radius=min_curvature_radius,
+        conjugate=conjugate,
     )
     # the binding limit is the one with the smaller relative margin
     alpha_binding = m_alpha / max(max_pressure_angle, 1e-12) < m_rho / max(min_curvature_radius, 1.0)
@@ -169,6 +254,7 @@ def min_pivot_distance(
     max_pressure_angle: float = math.pi / 2,
     min_curvature_radius: float = 0.0,
     step: float | None = None,
+    conjugate: ConjugateSpec | None = None,
 ) -> SizingResult:
     """The smallest pivot distance d [mm] of an oscillating follower meeting both limits, at the cam's r_b.
 
@@ -176,10 +262,13 @@ def min_pivot_distance(
     """
     if not cam.follower.kind.oscillating:
         raise DesignError("follower.type", "sizing the pivot distance needs an oscillating follower")
-    return _arm_search(cam, cam.sample_phi(step), "pivot_distance", max_pressure_angle, min_curvature_radius)
+    phi = cam.sample_phi(step)
+    return _arm_search(cam, phi, "pivot_distance", max_pressure_angle, min_curvature_radius, conjugate)
 
 
-def _arm_search(cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min: float) -> SizingResult:
+def _arm_search(
+    cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min: float, conjugate: ConjugateSpec | None
+) -> SizingResult:
     """Smallest r_b or d of an oscillating follower meeting both limits at their true extremes.
 
     For an arm neither limit is monotonic in r_b or d (the pressure angle at a
@@ -222,7 +311,7 @@ def _arm_search(cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min:
 
     def ok(x: float) -> bool:
         trial = make(x)
-        return trial is not None and _ok(trial, phi, alpha_max, rho_min)
+        return trial is not None and _ok(trial, phi, alpha_max, rho_min, conjugate)
 
     # the design's own value joins the grid: a design that meets the limits (an optimum, where the
     # feasible set can be a sliver narrower than the grid step) always has an answer at or below it
@@ -249,7 +338,7 @@ def _arm_search(cam: Cam, phi: FloatArray, knob: str, alpha_max: float, rho_min:
     best = make(good)
     assert best is not None
     m_alpha, m_rho, worst_alpha, worst_rho = feasible_margins(
-        best, phi, max_pressure_angle=alpha_max, min_curvature_radius=rho_min
+        best, phi, max_pressure_angle=alpha_max, min_curvature_radius=rho_min, conjugate=conjugate
     )
     alpha_binding = m_alpha / max(alpha_max, 1e-12) < m_rho / max(rho_min, 1.0)
     limit, worst = ("pressure angle", worst_alpha) if alpha_binding else ("curvature", worst_rho)

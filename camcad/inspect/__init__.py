@@ -26,9 +26,11 @@ from camcad.inspect.tolerance import (
     MonteCarlo,
     Tolerance,
     allocate,
+    draw,
     dwell_angles,
     linear_dwell,
     monte_carlo,
+    variant_figures,
 )
 
 __all__ = [
@@ -45,6 +47,7 @@ __all__ = [
     "actual_motion",
     "allocate",
     "compensate",
+    "draw",
     "dwell_angles",
     "foot_points",
     "inspect_points",
@@ -52,4 +55,5 @@ __all__ = [
     "monte_carlo",
     "points_from_polar",
     "smooth_deviation",
+    "variant_figures",
 ]

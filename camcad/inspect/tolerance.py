@@ -54,9 +54,11 @@ __all__ = [
     "MonteCarlo",
     "Tolerance",
     "allocate",
+    "draw",
     "dwell_angles",
     "linear_dwell",
     "monte_carlo",
+    "variant_figures",
 ]
 
 PERCENTILES = (0.135, 2.5, 50.0, 97.5, 99.865)
@@ -200,25 +202,15 @@ def monte_carlo(
         raise DesignError("tolerance.samples", f"{samples}; allowed: at least 2")
     deltas = _draw(tolerances, samples, seed)
     dwell = dwell_angles(cam)
-    marks = np.mod(dwell, 2.0 * np.pi)
-    phi = np.union1d(cam.sample_phi(step), marks) if peaks else np.unique(marks)
-    where = np.searchsorted(phi, np.mod(dwell, 2.0 * np.pi))
-    nominal = cam.motion(phi).s
+    phi = _grid(cam, dwell, step, peaks)
     per = max(1, _CHUNK // phi.size)
     dwell_err, acc, alpha = [], [], []
     for lo in range(0, samples, per):
         part = {k: v[lo : lo + per] for k, v in deltas.items()}
-        made = made_motion(cam, phi, deltas=part)
-        lift = made.lift.reshape(-1, phi.size)
-        dwell_err.append(lift[:, where] - nominal[where])
-        if not peaks:
-            acc.append(np.full(lift.shape[0], np.nan))
-            alpha.append(np.full(lift.shape[0], np.nan))
-            continue
-        acc.append(_peak(cam, phi, np.abs(made.acceleration.reshape(-1, phi.size)), part, "acceleration"))
-        alpha.append(
-            _peak(cam, phi, np.abs(made.pressure_angle.reshape(-1, phi.size)), part, "pressure_angle")
-        )
+        d_err, p_acc, p_alpha = variant_figures(cam, part, step=step, peaks=peaks)
+        dwell_err.append(d_err)
+        acc.append(p_acc)
+        alpha.append(p_alpha)
     dwell_error = np.vstack(dwell_err) if dwell.size else np.zeros((samples, 0))
     peak_acc, peak_alpha = np.concatenate(acc), np.concatenate(alpha)
     pct: dict[str, FloatArray] = {
@@ -237,6 +229,48 @@ def monte_carlo(
         peak_pressure_angle=peak_alpha,
         percentiles=pct,
     )
+
+
+def draw(tolerances: Sequence[Tolerance], *, samples: int, seed: int) -> dict[Tol, FloatArray]:
+    """The errors of ``samples`` made cams, each (V,) (mm; ``PHASE`` rad), as :func:`monte_carlo` draws them.
+
+    Unchecked: :func:`linear_dwell` or :func:`monte_carlo` on the cam checks the tolerances.
+    """
+    return _draw(tolerances, samples, seed)
+
+
+def _grid(cam: Cam, dwell: FloatArray, step: float, peaks: bool) -> FloatArray:
+    marks = np.mod(dwell, 2.0 * np.pi)
+    out: FloatArray = np.union1d(cam.sample_phi(step), marks) if peaks else np.unique(marks)
+    return out
+
+
+def variant_figures(
+    cam: Cam,
+    deltas: Mapping[Tol, FloatArray],
+    *,
+    step: float = math.radians(1.0),
+    peaks: bool = True,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """One batch of made cams re-solved together: dwell errors (V, D), peak |a| (V,), peak |α| (V,).
+
+    What :func:`monte_carlo` computes for each of its batches (see there for
+    the units); a batch's figures depend only on the variants in it, so the
+    same batches give the same bytes on any machine or worker.
+    """
+    dwell = dwell_angles(cam)
+    phi = _grid(cam, dwell, step, peaks)
+    where = np.searchsorted(phi, np.mod(dwell, 2.0 * np.pi))
+    nominal = cam.motion(phi).s
+    made = made_motion(cam, phi, deltas=deltas)
+    lift = made.lift.reshape(-1, phi.size)
+    dwell_err: FloatArray = lift[:, where] - nominal[where]
+    if not peaks:
+        nan: FloatArray = np.full(lift.shape[0], np.nan)
+        return dwell_err, nan, nan.copy()
+    acc = _peak(cam, phi, np.abs(made.acceleration.reshape(-1, phi.size)), deltas, "acceleration")
+    alpha = _peak(cam, phi, np.abs(made.pressure_angle.reshape(-1, phi.size)), deltas, "pressure_angle")
+    return dwell_err, acc, alpha
 
 
 def _peak(

@@ -25,7 +25,6 @@ from camcad._plots.design import (
     bore_outline,
     family_caption,
     follower_drawings,
-    further_plates,
 )
 from camcad.design import parse_design
 from camcad.errors import CamcadError, DesignError
@@ -86,8 +85,12 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
         inner, outer = (_xy(cam.offset(geo.phi, flank.offset).point) for flank in pocket.flanks)
         groove = {"outer_radius": pocket.outer_radius, "inner": inner, "outer": outer, "width": pocket.width}
     second = None
-    for plate in further_plates(analysis):  # a pair's second plate
-        outline = np.asarray(plate.profile(geo.phi).point)
+    for result in analysis.parts[1:]:  # a pair's second plate
+        if not result.part.made or result.part.pocket is not None:
+            continue
+        plate, later = result.part.cam, result.geometry  # its profile on the same grid, as analysed
+        same = np.array_equal(later.phi, geo.phi)
+        outline = np.asarray(later.profile.point if same else plate.profile(geo.phi).point)
         second = {"profile": _xy(outline), "followers": _followers(analysis, reach, plate)}
     return {
         "groove": groove,

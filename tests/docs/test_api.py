@@ -76,8 +76,18 @@ def test_figures_equal_those_camcad_check_prints(path, capsys):
     result = camcad.analyse(camcad.load(path), toolpath=False)
     code, rows, limits = check_table(path, capsys)
     lift = rows["lift"] if "lift" in rows else rows["arm swing"]
-    assert lift == shown(result.lift, 3, " mm" if result.lift_unit == "mm" else "°")
-    limit = f" (limit {result.pressure_angle_limit.value:g}°)"
+    unit = " mm" if result.lift_unit == "mm" else "°"
+    expected = shown(result.lift, 3, unit)
+    if round(result.stroke.value, 3) != round(result.lift.value, 3):  # the true travel beside the lift
+        low, high = (round(q.value, 3) + 0.0 for q in (result.travel_min, result.travel_max))
+        expected += (
+            f" (true stroke {result.stroke.value:.3f}{unit}: {low:.3f}{unit} to {high:.3f}{unit}"
+            f" at {result.travel_max.angle_deg:.1f}°)"
+        )
+    assert lift == expected
+    assert math.isclose(result.stroke.value, result.travel_max.value - result.travel_min.value, abs_tol=1e-9)
+    limit = f" (limit {result.pressure_angle_limit.value:g}°"
+    limit += f"; {result.pressure_angle_flank} flank drives)" if result.pressure_angle_flank else ")"
     assert rows["max pressure angle"] == shown(result.max_pressure_angle, 2, "°") + limit
     assert rows["min curvature radius"] == shown(result.min_curvature_radius, 3, " mm")
     assert rows["min concave radius"] == shown(result.min_concave_radius, 3, " mm")
@@ -85,7 +95,8 @@ def test_figures_equal_those_camcad_check_prints(path, capsys):
     assert rows["max torque"] == shown(result.max_torque, 1, " N·mm")
     assert rows["max contact force"] == shown(result.max_contact_force, 2, " N")
     assert rows["min contact force"] == shown(result.min_contact_force, 2, " N")
-    assert rows["max contact stress"] == shown(result.max_contact_stress, 1, " MPa")
+    flank = f" ({result.contact_stress_flank} flank)" if result.contact_stress_flank else ""
+    assert rows["max contact stress"] == shown(result.max_contact_stress, 1, " MPa") + flank
     jump = "none (positive drive)" if result.follower_jump is None else yes_no(result.follower_jump)
     assert rows["follower jump"] == jump
     fit = rows["fit control points"]

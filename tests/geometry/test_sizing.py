@@ -59,3 +59,38 @@ def test_sized_radius_passes_and_a_smaller_one_fails():
             min_curvature_radius=2.0,
         )
         assert (m_alpha >= 0 and m_rho >= 0) is ok
+
+
+def test_a_conjugate_pair_is_sized_for_both_plates():
+    """A yoke whose 40 mm second roller undercuts its plate first: sized with ``conjugate=``, the pair
+    passes check's own undercut test on both plates, and 1 µm smaller the second plate loops."""
+    from camcad.design import parse_design
+    from camcad.pipeline import analyse
+
+    data = {
+        "cam": {"name": "yoke", "base_radius": 60.0, "style": "conjugate", "max_pressure_angle": 80.0},
+        "follower": {"type": "translating-roller", "roller_radius": 6.0},
+        "conjugate": {"angle": 180.0, "roller_radius": 40.0},
+        "motion": [
+            {"kind": "rise", "angle": 100.0, "lift": 30.0, "law": "cycloidal"},
+            {"kind": "dwell", "angle": 80.0},
+            {"kind": "return", "angle": 100.0, "lift": 30.0, "law": "cycloidal"},
+            {"kind": "dwell", "angle": 80.0},
+        ],
+    }
+    design = parse_design(data)
+    cam = Cam.from_design(design)
+    alpha = design.cam.max_pressure_angle
+    first = min_base_radius(cam, max_pressure_angle=alpha)
+    pair = min_base_radius(cam, max_pressure_angle=alpha, conjugate=design.conjugate)
+    assert pair.limit == "curvature" and pair.base_radius > first.base_radius + 1.0
+
+    def findings(radius: float) -> list[str]:
+        data["cam"]["base_radius"] = radius
+        return [
+            f.message for f in analyse(parse_design(data), fit=False, toolpath=False, strict=False).findings
+        ]
+
+    assert findings(pair.base_radius) == []
+    below = findings(pair.base_radius - 1e-6)
+    assert below and all(m.startswith("second plate:") and "undercut" in m for m in below)

@@ -25,9 +25,10 @@ if TYPE_CHECKING:
     from camcad._typing import FloatArray
     from camcad.dynamics.spec import DynamicsSpec
     from camcad.dynamics.vibration.spec import VibrationSpec
+    from camcad.extremes import Side
     from camcad.motion.program import MotionProgram
 
-__all__ = ["VibrationResult", "analyse_vibration"]
+__all__ = ["VibrationResult", "analyse_vibration", "correction_max"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -68,10 +69,10 @@ class VibrationResult:
             ],
         }
         if self.compensated is not None:
-            phi = np.linspace(0.0, 2.0 * math.pi, 3600, endpoint=False)
-            corr = self.compensated.correction(phi)
+            value, where = correction_max(self.compensated)
             out["compensate_rpm"] = self.compensated.speed_rpm
-            out[f"lift_correction_max_{self.unit}"] = float(np.max(np.abs(corr)))
+            out[f"lift_correction_max_{self.unit}"] = value
+            out["lift_correction_max_angle_deg"] = round(math.degrees(where), 6)
         return out
 
     def response_rows(self) -> list[tuple[str, ...]]:
@@ -101,6 +102,39 @@ class VibrationResult:
                 )
             )
         return rows
+
+
+def correction_max(cam: CompensatedMotion) -> tuple[float, float]:
+    """The true largest |c − y| [lift unit] and its angle [rad]: a 0.1° grid with the joints, then Newton.
+
+    Newton's steps on (c − y)′ = 0 use the exact (c − y)″; the joints' one-sided
+    values are candidates too, so the figure is the true extreme, not a sample's.
+    """
+    joints = np.mod(np.asarray(cam.program.pieces, dtype=float), 2.0 * math.pi)
+    phi = np.union1d(np.linspace(0.0, 2.0 * math.pi, 3600, endpoint=False), joints)
+
+    def diff(p: FloatArray, side: Side = "right") -> tuple[FloatArray, FloatArray, FloatArray]:
+        c, y = cam.evaluate(p, side=side), cam.program.evaluate(p, side=side)
+        return c.s - y.s, c.v - y.v, c.a - y.a
+
+    e, _, _ = diff(phi)
+    k = int(np.argmax(np.abs(e)))
+    best, where = abs(float(e[k])), float(phi[k])
+    x, half = float(phi[k]), 2.0 * math.pi / 3600
+    for _ in range(8):
+        _, d1, d2 = diff(np.array([x]))
+        if d2[0] == 0.0:
+            break
+        x = min(max(x - float(d1[0] / d2[0]), float(phi[k]) - half), float(phi[k]) + half)
+        value = abs(float(diff(np.array([x]))[0][0]))
+        if value > best:
+            best, where = value, x
+    for side in ("left", "right"):
+        ej, _, _ = diff(joints, side)  # type: ignore[arg-type]
+        if ej.size and float(np.max(np.abs(ej))) > best:
+            i = int(np.argmax(np.abs(ej)))
+            best, where = float(abs(ej[i])), float(joints[i])
+    return best, where % (2.0 * math.pi)
 
 
 def analyse_vibration(
@@ -164,7 +198,8 @@ def analyse_vibration(
                 message=(
                     f"the elastic follower train leaves the cam at {math.degrees(first):.2f}° "
                     f"at {speed_rpm:g} rpm "
-                    f"(contact force would reach {response.contact_force_min.value:.4g}): raise the spring "
+                    f"(contact force would reach {response.contact_force_min.value:.4g} "
+                    f"{'N·mm' if arm_angle is not None else 'N'}): raise the spring "
                     "preload or rate, stiffen the train, or lower the speed"
                 ),
                 angle=first,

@@ -17,7 +17,7 @@ a law that is not is refused, naming ``motion[i].law``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -27,15 +27,14 @@ from camcad.angles import TWO_PI
 from camcad.dynamics.vibration._exact import Grid, grid_nodes, hermite, periodic_states, propagate
 from camcad.dynamics.vibration._higher import check_supported, program_derivatives
 from camcad.errors import DesignError
-from camcad.motion.program import Breakpoint, Motion
+from camcad.motion.program import Breakpoint, Motion, MotionProgram
 from camcad.motion.segments import SegmentKind, SegmentSpec
 
 if TYPE_CHECKING:
     from camcad.dynamics.vibration.train import Train
     from camcad.extremes import Side
-    from camcad.motion.program import MotionProgram
 
-__all__ = ["CompensatedMotion", "compensate"]
+__all__ = ["CompensatedMotion", "check_compensable", "compensate", "compensated_program"]
 
 _RPM = 60.0 / TWO_PI
 _JUMP_RTOL = 1e-9
@@ -210,6 +209,19 @@ def _check_smooth(program: MotionProgram) -> None:
                 )
 
 
+def check_compensable(program: MotionProgram) -> None:
+    """Refuse a program a polydyne cam cannot be made from (the checks :func:`compensate` runs first).
+
+    Raises
+    ------
+    DesignError
+        ``motion[i].law``: a law without closed-form higher derivatives, or a
+        lift not continuous to its 4th derivative at some joint (exit 2).
+    """
+    check_supported(program)
+    _check_smooth(program)
+
+
 def compensate(
     program: MotionProgram, train: Train, *, speed_rpm: float, step: float = math.radians(0.5)
 ) -> CompensatedMotion:
@@ -242,8 +254,7 @@ def compensate(
     """
     if not (math.isfinite(speed_rpm) and speed_rpm > 0.0):
         raise DesignError("vibration.compensate_rpm", f"{speed_rpm!r} must be a finite speed > 0 rpm")
-    check_supported(program)
-    _check_smooth(program)
+    check_compensable(program)
     t = train
     if t.dof == 1:
         specs = [(t.contact_rate, t.contact_damping, t.mass[0], t.weight[0])]
@@ -319,3 +330,76 @@ def _stage_input(
         x = x[: e.shape[0]] + e
         p = p[: x.shape[0] - 2]
     raise AssertionError("stage index out of range")
+
+
+@dataclass(frozen=True, slots=True)
+class CompensatedProgram(MotionProgram):
+    """A polydyne cam's contact lift c(φ) as a :class:`MotionProgram`: what the geometry stage cuts.
+
+    The segments, starts and joints are the motion program's (its kinds, laws
+    and lifts name what the *output* does), but every evaluation gives c and
+    its exact φ-derivatives from :class:`CompensatedMotion`; :attr:`lift` is
+    c's true largest value. Everything built on ``Cam.program`` (profile,
+    fit, toolpath, every export) is then made from c, not from the program.
+    """
+
+    # equality and hash by what decides c (program, train, speed), not by the solver's arrays
+    compensated: CompensatedMotion | None = field(default=None, compare=False, hash=False)
+    train: Train | None = None
+    speed_rpm: float = 0.0
+    _peak: dict[str, float] = field(default_factory=dict, init=False, compare=False, hash=False, repr=False)
+
+    def _evaluate_segment(
+        self, index: int, x: FloatArray, side: Side = "right"
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """c, c′, c″, c‴ on segment ``index`` at normalised x ∈ [0, 1] (one-sided: ``side``)."""
+        assert self.compensated is not None
+        span = self.segments[index].span
+        phi = self.starts[index] + np.asarray(x, dtype=float) * span
+        # a segment's end is the left limit at the next start, its start the right limit
+        at_end = np.asarray(x, dtype=float) >= 1.0
+        out = [np.zeros_like(phi) for _ in range(4)]
+        for mask, where in ((~at_end, side if side == "left" else "right"), (at_end, "left")):
+            if mask.any():
+                m = self.compensated.evaluate(phi[mask], side=where)  # type: ignore[arg-type]
+                for k, values in enumerate((m.s, m.v, m.a, m.j)):
+                    out[k][mask] = values
+        return out[0], out[1], out[2], out[3]
+
+    @property
+    def lift(self) -> float:
+        """Largest contact lift c [lift unit]: a 0.05° grid and the joints, polished by Newton on c′ = 0."""
+        assert self.compensated is not None
+        if "lift" not in self._peak:  # asked for at every joint's derivative scale: found once
+            self._peak["lift"] = _largest(self.compensated)
+        return self._peak["lift"]
+
+
+def _largest(cam: CompensatedMotion) -> float:
+    """The true maximum of c: the densest sample, then Newton steps on c′ = 0 with c″ (exact derivatives)."""
+    pieces = np.mod(np.asarray(cam.program.pieces, dtype=float), TWO_PI)
+    grid = np.union1d(np.linspace(0.0, TWO_PI, 7200, endpoint=False), pieces)
+    m = cam.evaluate(grid)
+    best = float(np.max(m.s))
+    k = int(np.argmax(m.s))
+    x = float(grid[k])
+    lo, hi = x - TWO_PI / 7200, x + TWO_PI / 7200
+    for _ in range(8):
+        here = cam.evaluate(np.array([x]))
+        a = float(here.a[0])
+        if a >= 0.0:  # not a smooth interior maximum (a joint or a flat rest): the sample stands
+            break
+        x = min(max(x - float(here.v[0]) / a, lo), hi)
+        best = max(best, float(cam.evaluate(np.array([x])).s[0]))
+    for joint in pieces:  # one-sided values at the joints
+        for side in ("left", "right"):
+            best = max(best, float(cam.evaluate(np.array([joint]), side=side).s[0]))  # type: ignore[arg-type]
+    return best
+
+
+def compensated_program(cam: CompensatedMotion) -> CompensatedProgram:
+    """The polydyne cam's contact lift as a motion program (see :class:`CompensatedProgram`)."""
+    p = cam.program
+    return CompensatedProgram(
+        p.segments, p.starts, p.base_s, compensated=cam, train=cam.train, speed_rpm=cam.speed_rpm
+    )

@@ -241,7 +241,7 @@ def train_response(
     if leaves:
         start = float(phi[int(np.argmax(force))])
         i0 = int(np.argmax(force))
-        hybrid = periodic_with_flight(program, train, omega=omega, start=start, state=z[i0])
+        hybrid = periodic_with_flight(program, train, omega=omega, start=start, state=z[i0], grid=grid)
         zh, contact = hybrid.state(phi)
         x = zh[:, train.dof - 1] / u
         force = np.where(contact, _force(train, grid.s, grid.v, omega, zh), 0.0)

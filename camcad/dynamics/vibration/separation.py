@@ -25,6 +25,7 @@ from camcad._typing import FloatArray
 from camcad.angles import TWO_PI
 
 if TYPE_CHECKING:
+    from camcad.dynamics.vibration._exact import Grid
     from camcad.dynamics.vibration.polydyne import CompensatedMotion
     from camcad.dynamics.vibration.train import Train
     from camcad.motion.program import MotionProgram
@@ -73,6 +74,21 @@ class HybridMotion:
         return out, contact
 
 
+def _hermite_lift(grid: Grid, phi: float, omega: float, unit: float) -> tuple[float, float]:
+    """Lift s and ṡ [generalised units, per s] at ``phi`` [rad] from the grid's Hermite polynomials."""
+    p = phi % TWO_PI
+    i = min(max(int(np.searchsorted(grid.phi, p, side="right")) - 1, 0), grid.piece.size - 1)
+    h = float(grid.step[grid.piece[i]])
+    u = (p - float(grid.phi[i])) / h
+    e = grid.coeff[i]
+    s = ds = 0.0
+    for k in range(e.size - 1, 0, -1):  # Horner for s and s′ together
+        ds = ds * u + k * e[k]
+        s = s * u + e[k]
+    s = s * u + e[0]
+    return s * unit, ds / h * omega * unit
+
+
 def periodic_with_flight(
     program: MotionProgram | CompensatedMotion,
     train: Train,
@@ -80,6 +96,7 @@ def periodic_with_flight(
     omega: float,
     start: float,
     state: FloatArray,
+    grid: Grid | None = None,
 ) -> HybridMotion:
     """Iterate the turn map with free flights to the periodic motion.
 
@@ -96,6 +113,11 @@ def periodic_with_flight(
         solution presses hardest.
     state
         The contact-held periodic state there (the first guess).
+    grid
+        The response's grid (:func:`~camcad.dynamics.vibration._exact.make_grid`):
+        the integrator then reads the lift from its degree-7 Hermite pieces,
+        the same lift the contact-held solution is exact for, at a few µs a
+        call instead of a program evaluation's 0.5 ms.
     """
     n = 2 * train.dof
     a, bs, bv, f = train.state_space()
@@ -105,6 +127,8 @@ def periodic_with_flight(
     relax = kf / cf if cf > 0.0 else math.inf
 
     def lift(t: float) -> tuple[float, float]:
+        if grid is not None:
+            return _hermite_lift(grid, omega * t, omega, unit)
         m = program.evaluate(np.array([omega * t]))
         return float(m.s[0]) * unit, float(m.v[0]) * omega * unit
 
