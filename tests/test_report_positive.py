@@ -34,8 +34,7 @@ def _centres(drawings) -> np.ndarray:
 
 def test_second_rollers_are_drawn_on_the_second_plate() -> None:
     analysis = analysed("indexing_conjugate.toml")
-    partner = analysis.positive.partner
-    assert partner is not None
+    partner = analysis.parts[1].part.cam
     drawings = follower_drawings(analysis, 100.0, cam=partner)
     plate = partner.profile(DENSE).point
     gap = distance_to_polygon(_centres(drawings), plate)

@@ -20,7 +20,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from camcad._plots._base import trace_name
-from camcad._plots.design import CURVATURE_CLIP, _positive_caption, bore_outline, follower_drawings
+from camcad._plots.design import (
+    CURVATURE_CLIP,
+    bore_outline,
+    family_caption,
+    follower_drawings,
+)
 from camcad.design import parse_design
 from camcad.errors import CamcadError, DesignError
 from camcad.pipeline import analyse
@@ -74,25 +79,19 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
     profile = np.asarray(geo.profile.point)
     pitch = np.asarray(geo.pitch.point)
     reach = float(max(np.hypot(*pitch.T).max() + cam.roller_radius, np.hypot(*profile.T).max()))
-    positive = analysis.positive
+    pocket = analysis.parts[0].part.pocket
     groove = None
-    if positive.groove is not None and spec.outer_radius is not None:  # as the report draws it
-        g, phi = positive.groove, geo.phi
-        groove = {
-            "outer_radius": spec.outer_radius,
-            "inner": _xy(cam.offset(phi, g.inner_offset).point),
-            "outer": _xy(cam.offset(phi, g.outer_offset).point),
-            "width": g.width,
-        }
+    if pocket is not None:  # as the report draws it
+        inner, outer = (_xy(cam.offset(geo.phi, flank.offset).point) for flank in pocket.flanks)
+        groove = {"outer_radius": pocket.outer_radius, "inner": inner, "outer": outer, "width": pocket.width}
     second = None
-    partner = positive.partner if positive.second_plate else None
-    if partner is not None:
-        plate = positive.partner_geometry  # its profile on the same grid, as analysed: not evaluated again
-        same = plate is not None and np.array_equal(plate.phi, geo.phi)
-        outline = np.asarray(
-            plate.profile.point if same and plate is not None else partner.profile(geo.phi).point
-        )
-        second = {"profile": _xy(outline), "followers": _followers(analysis, reach, partner)}
+    for result in analysis.parts[1:]:  # a pair's second plate
+        if not result.part.made or result.part.pocket is not None:
+            continue
+        plate, later = result.part.cam, result.geometry  # its profile on the same grid, as analysed
+        same = np.array_equal(later.phi, geo.phi)
+        outline = np.asarray(later.profile.point if same else plate.profile(geo.phi).point)
+        second = {"profile": _xy(outline), "followers": _followers(analysis, reach, plate)}
     return {
         "groove": groove,
         "second": second,
@@ -104,7 +103,7 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
         "rotation": cam.rotation.value,
         "caption": f"To scale, cam frame at φ = 0, turning {cam.rotation.value}: the profile (filled), the "
         f"{trace_name(analysis)} (dashed), the base circle r = {cam.base_radius:g} mm (dotted) and "
-        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°." + _positive_caption(analysis),
+        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°." + family_caption(analysis),
         "profile_radius_max": float(np.hypot(*profile.T).max()),
     }
 
