@@ -362,7 +362,8 @@ def extremes_rows(
     k = len(kinds)
 
     def pick(phi: FloatArray, rows: np.ndarray, side: Side) -> FloatArray:
-        return _rows(quantity(phi, side), k)[rows, np.arange(phi.size)]
+        out: FloatArray = _rows(quantity(phi, side), k)[rows, np.arange(phi.size)]
+        return out
 
     return _extremes(quantity, pick, grid, joints, kinds, values)
 
