@@ -68,11 +68,7 @@ def test_the_design_file_example_loads():
 
 
 # Fields the code's findings name that are no key of the design file. The list only shrinks.
-KNOWN_NOT_KEYS = {
-    # camcad/dynamics/life.py names it for a short track life; the file's keys are track_slope and
-    # track_intercept (the README states the field the finding names)
-    "life.track_material",
-}
+KNOWN_NOT_KEYS: set[str] = set()
 
 
 def _fields() -> set[str]:
