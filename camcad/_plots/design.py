@@ -200,12 +200,21 @@ def dynamics_plot(analysis: Analysis) -> Plot:
     stress_lines = [] if spec.allowable_stress is None else [
         HLine(y=spec.allowable_stress, label=f"allowable {spec.allowable_stress:g} MPa")
     ]  # fmt: skip
+    # a conjugate pair: the second plate's own force and stress (its roller, its dynamics), same code
+    dyn2 = analysis.positive.partner_dynamics
+    one = "plate 1" if dyn2 is not None else ""
+    force = [_curve(phi, dyn.contact_force, COLORS[4], label=one)]
+    stress = [_curve(phi, dyn.hertz_stress, COLORS[6], label=one)]
+    if dyn2 is not None:
+        phi2 = np.degrees(np.asarray(dyn2.phi))
+        force.append(_curve(phi2, dyn2.contact_force, COLORS[1], label="plate 2"))
+        stress.append(_curve(phi2, dyn2.hertz_stress, COLORS[1], label="plate 2"))
     panels = [
-        Panel(ylabel="contact force\nF [N]", series=[_curve(phi, dyn.contact_force, COLORS[4])],
-              lines=force_lines, legend=bool(force_lines), height=130.0),
+        Panel(ylabel="contact force\nF [N]", series=force,
+              lines=force_lines, legend=bool(force_lines) or dyn2 is not None, height=130.0),
         Panel(ylabel="input torque\nT [N·mm]", series=[_curve(phi, dyn.torque, COLORS[5])], height=130.0),
-        Panel(ylabel="Hertz stress\nσ [MPa]", series=[_curve(phi, dyn.hertz_stress, COLORS[6])],
-              lines=stress_lines, legend=bool(stress_lines), height=130.0),
+        Panel(ylabel="Hertz stress\nσ [MPa]", series=stress,
+              lines=stress_lines, legend=bool(stress_lines) or dyn2 is not None, height=130.0),
     ]  # fmt: skip
     bounds_deg, _ = _segments(analysis)
     return Plot(

@@ -72,6 +72,7 @@ from urllib.parse import parse_qs, urlsplit
 
 from camcad.design import load_design, parse_design
 from camcad.errors import CamcadError, DesignError, UsageError
+from camcad.export.records import json_safe
 from camcad.serve.form import design_data, form_groups
 from camcad.serve.page import STATIC, render_page
 from camcad.serve.payload import evaluate
@@ -501,7 +502,9 @@ class _Handler(BaseHTTPRequestHandler):
             self.wfile.write(body)
 
     def _json(self, status: int, data: Any) -> None:
-        self._send(status, json.dumps(data, allow_nan=False).encode("utf-8"), "application/json")
+        # non-finite numbers as null, as summary.json writes them (camcad.export.records.json_safe)
+        body = json.dumps(json_safe(data), allow_nan=False)
+        self._send(status, body.encode("utf-8"), "application/json")
 
     def _refuse(self, status: int, message: str, extra: Mapping[str, str] | None = None) -> None:
         self.close_connection = True

@@ -147,10 +147,35 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
         _chart("torque", "Input torque", "N·mm", one("T", dyn.torque), []),
         _chart("stress", "Hertz stress", "MPa", one("σ", dyn.hertz_stress), stress_limits),
     ]
+    _second_plate_curves(analysis, charts, index)
     points = _table_points(analysis)
     if points is not None:
         charts[0]["points"] = points
     return _series(np.degrees(phi), index), charts
+
+
+def _second_plate_curves(analysis: Analysis, charts: list[dict[str, Any]], index: np.ndarray) -> None:
+    """Add a conjugate pair's second plate (its own dynamics: force, torque share, stress) to ``charts``.
+
+    A groove's outer flank drives where the signed contact force is negative; its
+    force is drawn as its own series (magnitude, N) beside the inner flank's.
+    """
+    drive = analysis.positive
+    by_key = {c["key"]: c for c in charts}
+    dyn2 = drive.partner_dynamics
+    if dyn2 is not None and len(np.asarray(dyn2.contact_force)) == len(np.asarray(analysis.geometry.phi)):
+        by_key["force"]["series"][0]["label"] = "F plate 1"
+        by_key["force"]["series"].append({"label": "F plate 2", "y": _series(dyn2.contact_force, index)})
+        by_key["stress"]["series"][0]["label"] = "σ plate 1"
+        by_key["stress"]["series"].append({"label": "σ plate 2", "y": _series(dyn2.hertz_stress, index)})
+    if drive.groove is not None:
+        force = np.asarray(analysis.dynamics.contact_force, dtype=float)
+        inner = np.where(force >= 0.0, force, np.nan)  # gaps where the other flank drives
+        outer = np.where(force < 0.0, -force, np.nan)
+        by_key["force"]["series"] += [
+            {"label": "F inner flank drives", "y": _series(inner, index)},
+            {"label": "F outer flank drives (|F|)", "y": _series(outer, index)},
+        ]
 
 
 def _table_points(analysis: Analysis) -> dict[str, list[float]] | None:
