@@ -341,13 +341,14 @@ def _cmd_size(args: argparse.Namespace) -> int:
     from camcad.design import load_design
     from camcad.extremes import Extreme
     from camcad.geometry import Cam, min_base_radius, min_pivot_distance
-    from camcad.geometry.spec import CamStyle
+    from camcad.geometry.families import family_of
 
     design = load_design(args.design)
     cam = Cam.from_design(design)
     search = min_pivot_distance if args.pivot else min_base_radius
     # a conjugate pair: both plates within both limits (the second plate follows the first's radius)
-    conjugate = design.conjugate if design.cam.style is CamStyle.CONJUGATE else None
+    parts = family_of(design.cam.style).parts(cam, design.family_options())
+    conjugate = parts[-1].cam.conjugate  # a pair's second plate's tie to the first; None for one plate
     result = search(
         cam,
         max_pressure_angle=design.cam.max_pressure_angle,

@@ -201,20 +201,20 @@ def dynamics_plot(analysis: Analysis) -> Plot:
         HLine(y=spec.allowable_stress, label=f"allowable {spec.allowable_stress:g} MPa")
     ]  # fmt: skip
     # a conjugate pair: the second plate's own force and stress (its roller, its dynamics), same code
-    dyn2 = analysis.positive.partner_dynamics
-    one = "plate 1" if dyn2 is not None else ""
+    later = [r.dynamics for r in analysis.parts[1:]]  # every further part (a pair's second plate), same code
+    one = "plate 1" if later else ""
     force = [_curve(phi, dyn.contact_force, COLORS[4], label=one)]
     stress = [_curve(phi, dyn.hertz_stress, COLORS[6], label=one)]
-    if dyn2 is not None:
+    for i, dyn2 in enumerate(later, start=2):
         phi2 = np.degrees(np.asarray(dyn2.phi))
-        force.append(_curve(phi2, dyn2.contact_force, COLORS[1], label="plate 2"))
-        stress.append(_curve(phi2, dyn2.hertz_stress, COLORS[1], label="plate 2"))
+        force.append(_curve(phi2, dyn2.contact_force, COLORS[1], label=f"plate {i}"))
+        stress.append(_curve(phi2, dyn2.hertz_stress, COLORS[1], label=f"plate {i}"))
     panels = [
         Panel(ylabel="contact force\nF [N]", series=force,
-              lines=force_lines, legend=bool(force_lines) or dyn2 is not None, height=130.0),
+              lines=force_lines, legend=bool(force_lines) or bool(later), height=130.0),
         Panel(ylabel="input torque\nT [N·mm]", series=[_curve(phi, dyn.torque, COLORS[5])], height=130.0),
         Panel(ylabel="Hertz stress\nσ [MPa]", series=stress,
-              lines=stress_lines, legend=bool(stress_lines) or dyn2 is not None, height=130.0),
+              lines=stress_lines, legend=bool(stress_lines) or bool(later), height=130.0),
     ]  # fmt: skip
     bounds_deg, _ = _segments(analysis)
     return Plot(

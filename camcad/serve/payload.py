@@ -155,20 +155,29 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
 
 
 def _second_plate_curves(analysis: Analysis, charts: list[dict[str, Any]], index: np.ndarray) -> None:
-    """Add a conjugate pair's second plate (its own dynamics: force, torque share, stress) to ``charts``.
+    """Add every further part's own force and stress to ``charts`` (a conjugate pair's second plate).
 
-    A groove's outer flank drives where the signed contact force is negative; its
-    force is drawn as its own series (magnitude, N) beside the inner flank's.
+    Each part's curves come from its own dynamics (its roller, its drive sign),
+    by the same code as the first part's. Where a part carries a pocket (a
+    groove), the outer flank drives where the signed contact force is
+    negative; its force is drawn as its own series (magnitude, N) beside the
+    inner flank's.
     """
-    drive = analysis.positive
     by_key = {c["key"]: c for c in charts}
-    dyn2 = drive.partner_dynamics
-    if dyn2 is not None and len(np.asarray(dyn2.contact_force)) == len(np.asarray(analysis.geometry.phi)):
+    parts = analysis.parts
+    n = len(np.asarray(analysis.geometry.phi))
+    later = [
+        (i, r.dynamics)
+        for i, r in enumerate(parts[1:], start=2)
+        if len(np.asarray(r.dynamics.contact_force)) == n
+    ]
+    if later:
         by_key["force"]["series"][0]["label"] = "F plate 1"
-        by_key["force"]["series"].append({"label": "F plate 2", "y": _series(dyn2.contact_force, index)})
         by_key["stress"]["series"][0]["label"] = "σ plate 1"
-        by_key["stress"]["series"].append({"label": "σ plate 2", "y": _series(dyn2.hertz_stress, index)})
-    if drive.groove is not None:
+    for i, dyn in later:
+        by_key["force"]["series"].append({"label": f"F plate {i}", "y": _series(dyn.contact_force, index)})
+        by_key["stress"]["series"].append({"label": f"σ plate {i}", "y": _series(dyn.hertz_stress, index)})
+    if parts[0].part.pocket is not None:
         force = np.asarray(analysis.dynamics.contact_force, dtype=float)
         inner = np.where(force >= 0.0, force, np.nan)  # gaps where the other flank drives
         outer = np.where(force < 0.0, -force, np.nan)

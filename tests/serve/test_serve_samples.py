@@ -79,8 +79,8 @@ def test_designer_draws_the_second_plate_and_the_driving_flank():
     from camcad.design.schema import parse_design
 
     analysis = analyse(parse_design(tomllib.loads(text)), fit=False, toolpath=False, strict=False)
-    dyn2 = analysis.positive.partner_dynamics
-    grid = np.degrees(np.asarray(analysis.positive.partner_geometry.phi))
+    dyn2 = analysis.parts[1].dynamics  # the second plate, its own roller
+    grid = np.degrees(np.asarray(analysis.parts[1].geometry.phi))
     index = np.searchsorted(grid, phi - 1e-9)
     for key, name, values in (
         ("force", "F plate 2", dyn2.contact_force),
