@@ -1,7 +1,7 @@
 """Cost of issue 16's motion design: blend-point solves and point-table smoothing.
 
 Run ``python benchmarks/motion_blend.py``; prints the best of five wall-clock
-times per case (this project's 2-core machine: see the README).
+times per case and writes them to its section of benchmarks/README.md.
 """
 
 from __future__ import annotations
@@ -70,10 +70,15 @@ def main() -> None:
     for n in (360, 3600):
         phi, s = table(n)
         cases.append((f"table of {n} points", lambda phi=phi, s=s: smooth_table(phi, s, noise=0.005)))
+    print("| case | best time [ms] |")
+    print("| --- | ---: |")
     for name, fn in cases:
         repeat = 1 if "360 linked" in name else 5
-        print(f"{name:<40} {1000 * best(fn, repeat):9.1f} ms")
+        print(f"| {name} | {1000 * best(fn, repeat):.1f} |")
 
 
 if __name__ == "__main__":
-    main()
+    from _readme import captured  # this folder is on sys.path when the script runs
+
+    with captured("motion-blend"):  # the printed tables become its section of benchmarks/README.md
+        main()

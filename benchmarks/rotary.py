@@ -82,4 +82,7 @@ def main(tolerance: float = 0.005) -> None:
 
 
 if __name__ == "__main__":
-    main(float(sys.argv[1]) if len(sys.argv) > 1 else 0.005)
+    from _readme import captured  # this folder is on sys.path when the script runs
+
+    with captured("rotary"):  # the printed tables become its section of benchmarks/README.md
+        main(float(sys.argv[1]) if len(sys.argv) > 1 else 0.005)

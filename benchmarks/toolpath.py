@@ -136,4 +136,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _readme import captured  # this folder is on sys.path when the script runs
+
+    with captured("toolpath", fence=True):  # the printed tables become its section of benchmarks/README.md
+        main()

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -22,9 +22,9 @@ from camcad.extremes import SIDE_WORDS, Side, extremes_rows
 from camcad.findings import Finding
 from camcad.fit import ProfileFit
 from camcad.geometry import Cam, GeometryAnalysis
+from camcad.geometry.families import CamFamily, Part
 from camcad.motion.program import Motion
 from camcad.motion.table import table_summary
-from camcad.positive import PositiveDrive
 
 if TYPE_CHECKING:
     from camcad.dynamics.duty import DutyResult
@@ -33,7 +33,43 @@ if TYPE_CHECKING:
     from camcad.fea.results import FeaResult  # only typing: the FE package loads when the check runs
     from camcad.toolpath import Toolpath
 
-__all__ = ["Analysis", "motion_summary"]
+__all__ = ["Analysis", "PartResult", "motion_summary"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PartResult:
+    """What the stages computed for one part of a cam family, by the same code for every part.
+
+    Attributes
+    ----------
+    part
+        The part (:class:`camcad.geometry.families.Part`): its cam, its files' suffix, its shape.
+    geometry
+        Its pitch curve, profile, pressure angle, curvature, undercut.
+    dynamics
+        Its contact force, torque and Hertz stress, with its own roller and drive sign.
+    fit
+        The certified NURBS of its outline; None when not fitted or not made.
+    flank_fits
+        The certified NURBS of its further curves (``part.flanks``), in order; empty when not fitted.
+    gcode
+        Its program; None without a tool path, or when not made.
+    """
+
+    part: Part
+    geometry: GeometryAnalysis
+    dynamics: DynamicsResult
+    fit: ProfileFit | None = None
+    flank_fits: tuple[ProfileFit, ...] = ()
+    gcode: GcodeProgram | None = None
+
+    @property
+    def findings(self) -> tuple[Finding, ...]:
+        """Its geometry's findings, its family checks' and its dynamics'; a later part's name theirs."""
+        found = (*self.geometry.findings, *self.part.findings, *self.dynamics.findings)
+        if not self.part.label:
+            return found
+        return tuple(replace(f, message=f"{self.part.label}: {f.message}") for f in found)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -42,37 +78,30 @@ class Analysis:
 
     Attributes
     ----------
+    family
+        The cam family (plate, groove, conjugate) whose parts were analysed.
+    parts
+        What every stage computed for each part, the designed cam's first.
     motion
         s, v, a, j over ``geometry.phi`` (0.1° grid plus breakpoints).
-    geometry
-        Pitch curve, profile, pressure angle, curvature, undercut.
-    dynamics
-        Contact force, torque, Hertz stress (over the same angles).
-    fit
-        The certified NURBS of the profile, or None when not requested.
     toolpath
-        The planned toolpath, or None when not requested.
-    gcode
-        The toolpath rendered once in the design's dialect: the text of
-        ``cam.ngc`` and the summary's figures; None without a toolpath.
+        The first part's planned toolpath, or None when not requested (or rotary).
     timings
-        Seconds per stage.
+        Seconds per stage (all parts).
     stage_findings
         Hard limits the fit or the toolpath plan found (fit tolerance
         unreachable, gouge) when the analysis was not strict.
+
+    ``cam``, ``geometry``, ``dynamics``, ``fit`` and ``gcode`` are the first part's.
     """
 
     design: Design
-    cam: Cam
+    family: CamFamily
+    parts: tuple[PartResult, ...]
     motion: Motion
-    geometry: GeometryAnalysis
-    dynamics: DynamicsResult
-    fit: ProfileFit | None
     toolpath: Toolpath | None
-    gcode: GcodeProgram | None = None
     timings: dict[str, float] = field(default_factory=dict)
     stage_findings: tuple[Finding, ...] = ()
-    positive: PositiveDrive = field(default_factory=PositiveDrive)
     fea: FeaResult | None = None  # the finite-element check, when run ([fea] present, or asked for)
     duty: DutyResult | None = None  # life, film and drive ([life], [lubrication], [drive]; issue 35)
     vibration: VibrationResult | None = None  # the elastic follower train ([vibration]; issue 34)
@@ -81,12 +110,39 @@ class Analysis:
     )
 
     @property
+    def cam(self) -> Cam:
+        """The designed cam (the first part's)."""
+        return self.parts[0].part.cam
+
+    @property
+    def geometry(self) -> GeometryAnalysis:
+        """The first part's pitch curve, profile, pressure angle, curvature, undercut."""
+        return self.parts[0].geometry
+
+    @property
+    def dynamics(self) -> DynamicsResult:
+        """The first part's contact force, torque, Hertz stress (over the same angles)."""
+        return self.parts[0].dynamics
+
+    @property
+    def fit(self) -> ProfileFit | None:
+        """The certified NURBS of the first part's profile, or None when not requested."""
+        return self.parts[0].fit
+
+    @property
+    def gcode(self) -> GcodeProgram | None:
+        """The first part's program (the text of ``cam.ngc`` and its figures); None without a toolpath."""
+        return self.parts[0].gcode
+
+    @property
     def findings(self) -> tuple[Finding, ...]:
-        """Every broken limit of every stage, hard ones first (see :mod:`camcad.findings`)."""
+        """Every broken limit of every stage and part, hard ones first (see :mod:`camcad.findings`)."""
+        first, *later = self.parts
         found = (
-            *self.geometry.findings,
-            *self.positive.findings,
-            *self.dynamics.findings,
+            *first.geometry.findings,
+            *first.part.findings,
+            *(f for result in later for f in result.findings),
+            *first.dynamics.findings,
             *self.stage_findings,
             *(self.fea.findings if self.fea is not None else ()),
             *(self.duty.findings if self.duty is not None else ()),
@@ -122,12 +178,8 @@ class Analysis:
             "motion": copy.deepcopy(self._memo["motion"]),
             "geometry": self.geometry.summary(),
             "dynamics": self.dynamics.summary(),
-            **self.positive.summary(),
+            **self.family.summary(self.parts),  # a groove's flanks, a pair's second plate
         }
-        if "groove" in out:  # the pressure angle is the same on both flanks; say which one drives there
-            out["groove"]["pressure_angle_max_flank"] = _flank_at(
-                self.dynamics, self.geometry.pressure_angle_max.phi
-            )
         if self.fit is not None:
             out["fit"] = self.fit.summary()
         if self.gcode is not None:
@@ -142,15 +194,6 @@ class Analysis:
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]
         return out
-
-
-def _flank_at(dynamics: DynamicsResult, phi: float) -> str | None:
-    """The groove flank that drives at cam angle φ [rad]: the sign of the nearest sample's contact force."""
-    d = np.angle(np.exp(1j * (np.asarray(dynamics.phi) - phi)))  # wrapped distance [rad]
-    force = float(dynamics.contact_force[int(np.argmin(np.abs(d)))])
-    if force == 0.0:
-        return None  # a rest: neither flank drives
-    return "inner" if force > 0.0 else "outer"
 
 
 def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:

@@ -425,7 +425,7 @@ class Result:
         self.min_contact_force = _quantity(dyn, "contact_force_min", "N")
         self.max_contact_stress = _quantity(dyn, "hertz_stress_max", "MPa")
         self.contact_stress_flank: str | None = dyn.get("hertz_stress_max_flank")
-        positive = bool({"groove", "second_plate"} & set(summary))
+        positive = analysis.dynamics.positive_drive  # no spring holds it on: no jump check
         self.follower_jump: bool | None = None if positive else dyn.get("jump")
         self.fit_control_points: int | None = None if fit is None else int(fit["control_points"])
         self.fit_max_error = Quantity(value=None if fit is None else float(fit["max_error_mm"]), unit="mm")

@@ -341,14 +341,19 @@ def _cmd_size(args: argparse.Namespace) -> int:
     from camcad.design import load_design
     from camcad.extremes import Extreme
     from camcad.geometry import Cam, min_base_radius, min_pivot_distance
+    from camcad.geometry.families import family_of
 
     design = load_design(args.design)
     cam = Cam.from_design(design)
     search = min_pivot_distance if args.pivot else min_base_radius
+    # a conjugate pair: both plates within both limits (the second plate follows the first's radius)
+    parts = family_of(design.cam.style).parts(cam, design.family_options())
+    conjugate = parts[-1].cam.conjugate  # a pair's second plate's tie to the first; None for one plate
     result = search(
         cam,
         max_pressure_angle=design.cam.max_pressure_angle,
         min_curvature_radius=design.min_curvature_radius,
+        conjugate=conjugate,
     )
     if args.pivot:
         print(
@@ -356,7 +361,9 @@ def _cmd_size(args: argparse.Namespace) -> int:
             f"(design has {design.follower.pivot_distance:g} mm, base radius {design.cam.base_radius:g} mm)"
         )
     else:
-        print(f"smallest base radius: {result.base_radius:.3f} mm (design has {design.cam.base_radius:g} mm)")
+        # rounded up to the printed µm: the printed radius, typed back, meets the limits
+        shown = math.ceil(result.base_radius * 1000.0 - 1e-9) / 1000.0
+        print(f"smallest base radius: {shown:.3f} mm (design has {design.cam.base_radius:g} mm)")
     where = Extreme(value=0.0, phi=result.angle, side=result.side).where()
     print(f"  limited by {result.limit} {where.replace('at ', 'at cam angle ', 1)}")
     print(

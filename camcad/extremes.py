@@ -33,9 +33,11 @@ __all__ = [
     "Extreme",
     "Kind",
     "Quantity",
+    "RowPick",
     "Rows",
     "Side",
     "extremes",
+    "extremes_each",
     "extremes_rows",
     "maximum",
     "minimum",
@@ -50,6 +52,12 @@ Kind = Literal["min", "max"]
 
 Rows = Callable[[FloatArray, Side], ArrayLike]
 """Several quantities at once: cam angles (n,) [rad] and a side → values (k, n)."""
+
+RowPick = Callable[[FloatArray, np.ndarray, Side], ArrayLike]
+"""Many independent quantities: angles (n,) [rad], the row of each (n,) and a side → values (n,).
+
+Each row is evaluated only at its own angles (e.g. one row per cam speed).
+"""
 
 Quantity = Callable[[FloatArray, Side], FloatArray]
 """An exact quantity q(φ) [any unit]: cam angles (n,) [rad] and a side → values (n,).
@@ -386,6 +394,74 @@ def extremes_rows(
     tuple[Extreme, ...]
         One per row, in order.
     """
+
+    def pick(phi: FloatArray, rows: np.ndarray, side: Side) -> FloatArray:
+        out: FloatArray = _rows(quantity(phi, side), k)[rows, np.arange(phi.size)]
+        return out
+
+    k = len(kinds)
+    return _extremes(quantity, pick, grid, joints, kinds, values, rests=rests, settled=settled)
+
+
+def extremes_each(
+    pick: RowPick,
+    rows: int,
+    grid: ArrayLike,
+    joints: Sequence[float] | ArrayLike,
+    kinds: Sequence[Kind],
+    *,
+    values: ArrayLike | None = None,
+) -> tuple[Extreme, ...]:
+    """The true extremes of ``rows`` independent quantities, each evaluated only where its search needs it.
+
+    Same search as :func:`extremes_rows` (samples, both sides of every
+    joint, end-gap probes, vectorised Brent refinement of every promising
+    sampled peak), but the quantity is called with the row of every angle,
+    so one call serves the brackets of all rows at once without evaluating
+    every row at every angle: a speed map refines all its speeds together.
+
+    Parameters
+    ----------
+    pick
+        q(φ, row, side) → values (n,), see :data:`RowPick`.
+    rows
+        Number of quantities k.
+    grid, joints
+        As for :func:`extremes`; shared by every row.
+    kinds
+        ``"min"`` or ``"max"`` for each row (k,).
+    values
+        (k, n) the rows on the grid (right values) if already computed.
+
+    Returns
+    -------
+    tuple[Extreme, ...]
+        One per row, in order.
+    """
+
+    def full(phi: FloatArray, side: Side) -> FloatArray:
+        n = phi.size
+        which = np.repeat(np.arange(rows), n)
+        return np.asarray(pick(np.tile(phi, rows), which, side), dtype=float).reshape(rows, n)
+
+    def each(phi: FloatArray, which: np.ndarray, side: Side) -> FloatArray:
+        return np.asarray(pick(phi, which, side), dtype=float)
+
+    return _extremes(full, each, grid, joints, kinds, values)
+
+
+def _extremes(
+    quantity: Rows,
+    pick: RowPick,
+    grid: ArrayLike,
+    joints: Sequence[float] | ArrayLike,
+    kinds: Sequence[Kind],
+    values: ArrayLike | None,
+    *,
+    rests: Sequence[tuple[float, float]] = (),
+    settled: Sequence[bool] = (),
+) -> tuple[Extreme, ...]:
+    """:func:`extremes_rows` with ``quantity`` for whole rows and ``pick`` for one row per angle."""
     k = len(kinds)
     grid_a = np.asarray(grid, dtype=float)
     seq = _sequence(
@@ -411,10 +487,10 @@ def extremes_rows(
     if any(settled):
         searched: np.ndarray = np.logical_not(np.asarray(settled, dtype=bool))[br.row]
         br = _select(br, searched)
-    picker = _Picker(quantity, sign[:, 0], br.row, k)
+    picker = _Picker(pick, sign[:, 0], br.row)
     br = _probe_end_gaps(picker, br)
     if br.x1.size:
-        phi_best, f_best = _refine_max(_Picker(quantity, sign[:, 0], br.row, k), br)
+        phi_best, f_best = _refine_max(_Picker(pick, sign[:, 0], br.row), br)
         for r in range(k):
             mine = np.flatnonzero(br.row == r)
             if mine.size:
@@ -429,15 +505,14 @@ def extremes_rows(
 class _Picker:
     """f(φ) for the refinement: each bracket's own row of the quantity, signed so maxima are sought."""
 
-    quantity: Rows
+    pick: RowPick
     sign: FloatArray
     row: np.ndarray
-    k: int
 
     def __call__(self, phi: FloatArray, which: np.ndarray) -> FloatArray:
         """sign·q_row(φ) for the brackets ``which`` (indices), at their points ``phi``; nan → −inf."""
         rows = self.row[which]
-        out = self.sign[rows] * _rows(self.quantity(phi, "right"), self.k)[rows, np.arange(phi.size)]
+        out = self.sign[rows] * np.asarray(self.pick(phi, rows, "right"), dtype=float)
         return np.where(np.isnan(out), -np.inf, out)
 
 

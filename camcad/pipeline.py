@@ -8,31 +8,28 @@ the output folder only when every stage has succeeded.
 
 from __future__ import annotations
 
-import math
 import os
 import pickle
 import re
 import signal
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from camcad.analysis import Analysis, motion_summary
+from camcad.analysis import Analysis, PartResult, motion_summary
 from camcad.design import Design, load_design
-from camcad.dynamics import analyse_dynamics
+from camcad.dynamics import DynamicsResult, analyse_dynamics
 from camcad.errors import DesignLimitError, ExportError, FitError, GougeError, UsageError
 from camcad.export.atomic import staged_folder
-from camcad.export.records import write_csv, write_json, write_text
+from camcad.export.records import write_json, write_text
 from camcad.findings import Finding, Severity
-from camcad.fit import fit_cam_profile
-from camcad.geometry import Cam, analyse_geometry, undercut_error
-from camcad.positive import analyse_positive_drive, fit_positive_drive, plan_partner
+from camcad.fit import ProfileFit, fit_cam_profile
+from camcad.geometry import Cam, GeometryAnalysis, analyse_geometry, undercut_error
+from camcad.geometry.families import CamFamily, Part, family_of
 from camcad.toolpath.spec import Machine
 
 __all__ = [
@@ -70,8 +67,6 @@ OUTPUT_GROUPS: dict[str, tuple[str, ...]] = {
     "report": ("report.html",),
 }
 """What ``build --only`` selects; ``summary.json`` is always written."""
-
-MOTION_TABLE_STEP_DEG = 0.1
 
 
 def load(path: str | Path) -> Project:
@@ -160,37 +155,52 @@ def analyse(
             from camcad.dynamics.vibration import compensated_program
 
             cam = replace(cam, program=compensated_program(vibration.compensated))
-    geometry = _timed(
-        timings,
-        progress,
-        "geometry",
-        lambda: analyse_geometry(
-            cam,
+    family = family_of(design.cam.style)
+    parts = family.parts(cam, design.family_options())  # plate; a groove's blank; a pair's two plates
+
+    def geometry_of(part: Part) -> GeometryAnalysis:
+        return analyse_geometry(
+            part.cam,
             max_pressure_angle=design.cam.max_pressure_angle,
             face_width=design.follower.face_width,
             face_margin=design.follower.face_margin,
             min_curvature_radius=design.min_curvature_radius,
-        ),
-    )
-    motion = cam.motion(geometry.phi)
-    positive = analyse_positive_drive(design, cam)  # a groove's flanks, a conjugate pair's second plate
-    hard = [f for f in (*geometry.findings, *positive.findings) if f.hard]
+        )
+
+    geometries = _timed(timings, progress, "geometry", lambda: [geometry_of(part) for part in parts])
+    motion = cam.motion(geometries[0].phi)
+    hard = [
+        f
+        for part, geometry in zip(parts, geometries, strict=True)
+        for f in _labelled(part, (*geometry.findings, *part.findings))
+        if f.hard
+    ]
     if hard and strict:
-        if geometry.undercut is not None:
-            raise undercut_error(geometry, min_curvature_radius=design.min_curvature_radius)
+        if geometries[0].undercut is not None:
+            raise undercut_error(geometries[0], min_curvature_radius=design.min_curvature_radius)
         raise DesignLimitError(hard[0].message)
+    setup = design.dynamics_setup()
+
+    def dynamics_of(part: Part, geometry: GeometryAnalysis) -> DynamicsResult:
+        return analyse_dynamics(
+            part.cam.motion(geometry.phi),
+            pressure_angle=geometry.pressure_angle,
+            profile_rho=geometry.profile.rho,
+            # each part's own roller sets its Hertz contact (Johnson 1985, §4.3), its drive sign its force
+            setup=replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius),
+            cam=part.cam,
+        )
+
     dynamics = _timed(
         timings,
         progress,
         "dynamics",
-        lambda: analyse_dynamics(
-            motion,
-            pressure_angle=geometry.pressure_angle,
-            profile_rho=geometry.profile.rho,
-            setup=design.dynamics_setup(),
-            cam=cam,
-        ),
+        lambda: [dynamics_of(part, g) for part, g in zip(parts, geometries, strict=True)],
     )
+    results = [
+        PartResult(part=part, geometry=g, dynamics=d)
+        for part, g, d in zip(parts, geometries, dynamics, strict=True)
+    ]
     duty = None
     if design.life is not None or design.lubrication is not None or design.drive is not None:
         from camcad.dynamics.duty import analyse_duty
@@ -201,95 +211,85 @@ def analyse(
             "duty",
             lambda: analyse_duty(
                 cam,
-                dynamics,
-                setup=design.dynamics_setup(),
-                profile=geometry.profile,
+                dynamics[0],
+                setup=setup,
+                profile=geometries[0].profile,
                 life=design.life,
                 lubrication=design.lubrication,
                 drive=design.drive,
             ),
         )
     later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
-    fitted = planned = None
     if fit and not hard:
-
-        def fit_all() -> tuple[Any, Any]:  # the profile, then a groove's flanks or the second plate
-            limits = {"tolerance": design.fit.tolerance, "max_control_points": design.fit.max_control_points}
-            return fit_cam_profile(cam, **limits), fit_positive_drive(positive, cam, **limits)
-
-        fitted, positive = _limited(
-            fit_all, timings=timings, progress=progress, stage="fit", strict=strict, found=later
-        ) or (None, positive)
-    rotary = design.gcode.machine is Machine.ROTARY  # X + A/C in inverse time (camcad.toolpath.rotary)
-    if toolpath and not hard:
-        from camcad.toolpath import plan_toolpath
-        from camcad.toolpath.groove import plan_groove
-        from camcad.toolpath.rotary import plan_rotary
-
-        groove = positive.groove is not None  # a groove cam: slot and flank passes (camcad.toolpath.groove)
-        planned = _limited(
-            lambda: (
-                plan_groove(
-                    cam,
-                    design.gcode,
-                    name=design.cam.name,
-                    thickness=design.cam.thickness,
-                    depth=design.groove.depth,
-                    clearance=design.groove.clearance,
-                    bore=design.cam.bore,
-                )
-                if groove
-                else plan_rotary(cam, design.gcode, name=design.cam.name, thickness=design.cam.thickness)
-                if rotary
-                else plan_toolpath(
-                    cam,
-                    design.gcode,
-                    name=design.cam.name,
-                    thickness=design.cam.thickness,
-                    bore=design.cam.bore,
-                )
-            ),
-            timings=timings,
-            progress=progress,
-            stage="toolpath",
-            strict=strict,
-            found=later,
+        fit_curve = partial(
+            fit_cam_profile, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
         )
-    if planned is not None and positive.second_plate:
-        first = timings["toolpath"]
-        positive = (
+
+        def fit_part(result: PartResult) -> PartResult:  # its outline, then its further curves (flanks)
+            if not result.part.made:
+                return result
+            part = result.part
+            flanks = tuple(fit_curve(part.cam, offset=f.offset) for f in part.flanks)
+            return replace(result, fit=fit_curve(part.cam), flank_fits=flanks)
+
+        results = (
             _limited(
-                lambda: plan_partner(positive, design),
+                lambda: [fit_part(r) for r in results],
+                timings=timings,
+                progress=progress,
+                stage="fit",
+                strict=strict,
+                found=later,
+            )
+            or results
+        )
+    planned = None
+    if toolpath and not hard:
+        from camcad.export.gcode import render_program
+        from camcad.export.gcode.rotary import render_rotary_program
+        from camcad.toolpath.parts import plan_part
+
+        rotary = design.gcode.machine is Machine.ROTARY  # X + A/C in inverse time (camcad.toolpath.rotary)
+        render = render_rotary_program if rotary else render_program
+        spent = 0.0
+        for index, result in enumerate(results):
+            if not result.part.made:
+                continue
+            timings.pop("toolpath", None)
+            plan = _limited(
+                partial(
+                    plan_part,
+                    result.part,
+                    design.gcode,
+                    name=design.cam.name,
+                    thickness=design.cam.thickness,
+                    bore=design.cam.bore,
+                ),
                 timings=timings,
                 progress=progress,
                 stage="toolpath",
                 strict=strict,
                 found=later,
             )
-            or positive
-        )
-        timings["toolpath"] += first  # both plates' plans
+            spent += timings.pop("toolpath", 0.0)
+            if plan is None:
+                break
+            if index == 0:
+                planned = None if rotary else plan  # the rotary plan lives in its program (G93 text, figures)
+            results[index] = replace(result, gcode=render(plan, design.gcode.dialect))
+        if spent:
+            timings["toolpath"] = spent  # every part's plan
     fea_result = None
     if fea and not hard:
-        fea_result = _timed(timings, progress, "fea", lambda: _fea_check(design, cam, dynamics))
-    program = None
-    if planned is not None:
-        from camcad.export.gcode import render_program
-        from camcad.export.gcode.rotary import render_rotary_program
-
-        program = (render_rotary_program if rotary else render_program)(planned, design.gcode.dialect)
+        fea_result = _timed(timings, progress, "fea", lambda: _fea_check(design, family, parts, dynamics[0]))
     return Analysis(
         design=design,
-        cam=cam,
+        family=family,
+        parts=tuple(results),
         motion=motion,
-        geometry=geometry,
-        dynamics=dynamics,
-        fit=fitted,
-        toolpath=None if rotary else planned,  # the rotary plan lives in its program (G93 text, figures)
-        gcode=program,
+        toolpath=planned,
         timings=timings,
         stage_findings=tuple(later),
-        positive=positive,
         fea=fea_result,
         duty=duty,
         vibration=vibration,
@@ -312,16 +312,25 @@ def _vibration(design: Design, cam: Cam) -> Any:
     )
 
 
-def _fea_check(design: Design, cam: Cam, dynamics: Any) -> Any:
-    """The finite-element check with the design's ``[fea]`` table (its defaults when absent)."""
-    from camcad.fea import FeaSpec, analyse_fea
-    from camcad.geometry.spec import CamStyle
+def _labelled(part: Part, findings: Iterable[Finding]) -> list[Finding]:
+    """``findings`` of ``part``, their messages named by its label when it has one ("second plate: …")."""
+    if not part.label:
+        return list(findings)
+    return [replace(f, message=f"{part.label}: {f.message}") for f in findings]
 
-    if design.cam.style is not CamStyle.PLATE:
-        style = design.cam.style.value
-        raise UsageError("fea", f"the finite-element check applies to cam.style = 'plate' only, not {style}")
+
+def _fea_check(design: Design, family: CamFamily, parts: Sequence[Part], dynamics: DynamicsResult) -> Any:
+    """The FE check of a family's one plate with the design's ``[fea]`` table (its defaults when absent)."""
+    from camcad.fea import FeaSpec, analyse_fea
+
+    if len(parts) != 1 or parts[0].pocket is not None:  # the FE model is one plate cut along its outline
+        raise UsageError(
+            "fea", f"the finite-element check applies to cam.style = 'plate' only, not {family.name}"
+        )
     spec = design.fea if design.fea is not None else FeaSpec()
-    return analyse_fea(cam, design.plate(), setup=design.dynamics_setup(), dynamics=dynamics, spec=spec)
+    return analyse_fea(
+        parts[0].cam, design.plate(), setup=design.dynamics_setup(), dynamics=dynamics, spec=spec
+    )
 
 
 _STAGE_LIMITS: dict[str, tuple[type[DesignLimitError], str, str]] = {
@@ -569,33 +578,56 @@ def _write_files(
 
     if "tables" in groups:
         stage("tables", lambda: write_tables(analysis, folder))
+    made = [r for r in analysis.parts if r.part.made]  # a constant-breadth pair's second roller: no files
+    numbers = range(1, len(made) + 1) if len(made) > 1 else (0,)  # several parts: named 1, 2, … as mounted
     if "dxf" in groups:
-        from camcad.export.dxf import write_profile_arcs_dxf, write_profile_dxf, write_profile_poly_dxf
+        from camcad.export.dxf import write_part_dxfs
 
-        def dxf_files() -> list[Path]:
-            out = []
-            for suffix, plate_cam, fit in _plates(analysis):
-                for name, write in (
-                    ("profile", write_profile_dxf),
-                    ("profile_poly", write_profile_poly_dxf),
-                    ("profile_arcs", write_profile_arcs_dxf),
-                ):
-                    path = folder / f"{name}{suffix}.dxf"
-                    out.append(write(path, cam=plate_cam, fit=fit, plate=plate, options=design.dxf, **groove))
-            return out
-
-        groove = _groove_drawing(analysis)
-
-        stage("dxf", dxf_files)
+        stage(
+            "dxf",
+            lambda: [
+                path
+                for r in made
+                for path in write_part_dxfs(
+                    folder, r.part, fit=_fitted(r), flank_fits=r.flank_fits, plate=plate, options=design.dxf
+                )
+            ],
+        )
     if "stl" in groups:
-        stage("mesh", lambda: _write_solids(analysis, folder))
+        from camcad.export.mesh import write_part_meshes
+
+        mesh = design.mesh
+        stage(
+            "mesh",
+            lambda: [
+                path
+                for r in made
+                for path in write_part_meshes(
+                    folder,
+                    r.part,
+                    fit=_fitted(r),
+                    flank_fits=r.flank_fits,
+                    plate=plate,
+                    options=mesh,
+                    formats=mesh.formats,
+                )
+            ],
+        )
     if "step" in groups:
-        stage("step", lambda: _write_steps(analysis, folder))
+        from camcad.export.step import write_part_step
+
+        stage(
+            "step",
+            lambda: [
+                write_part_step(
+                    folder, r.part, fit=_fitted(r), flank_fits=r.flank_fits, plate=plate, number=n
+                )
+                for r, n in zip(made, numbers, strict=True)
+            ],
+        )
     if "gcode" in groups:
         assert analysis.gcode is not None  # analysed with the toolpath when G-code is asked for
-        programs = [("cam.ngc", analysis.gcode.text)]
-        if analysis.positive.partner_gcode is not None:
-            programs.append(("cam_2.ngc", analysis.positive.partner_gcode.text))
+        programs = [(f"cam{r.part.suffix}.ngc", r.gcode.text) for r in made if r.gcode is not None]
         stage("gcode", lambda: [write_text(folder / name, text) for name, text in programs])
     if "fea" in groups and analysis.fea is not None:
         from camcad.export.stress import write_stress_vtu
@@ -605,117 +637,28 @@ def _write_files(
     return written
 
 
-def _plates(analysis: Analysis) -> list[tuple[str, Cam, Any]]:
-    """The plates to export: (file suffix, cam, fit); a conjugate pair's second plate gets ``_2``."""
-    out: list[tuple[str, Cam, Any]] = [("", analysis.cam, analysis.fit)]
-    positive = analysis.positive
-    if positive.partner is not None and positive.partner_fit is not None:
-        out.append(("_2", positive.partner, positive.partner_fit))
-    return out
-
-
-def _groove_drawing(analysis: Analysis) -> dict[str, Any]:
-    """The DXF writers' ``curves`` and ``blank_radius`` for a groove cam (its flanks, the blank), else {}."""
-    from camcad.export.dxf import DxfCurve
-
-    groove, flanks = analysis.positive.groove, analysis.positive.flank_fits
-    if groove is None or flanks is None:
-        return {}
-    curves = (
-        DxfCurve(layer="GROOVE_INNER", fit=flanks[0], offset=groove.inner_offset),
-        DxfCurve(layer="GROOVE_OUTER", fit=flanks[1], offset=groove.outer_offset),
-    )
-    return {"curves": curves, "blank_radius": analysis.design.cam.outer_radius}
-
-
-def _write_solids(analysis: Analysis, folder: Path) -> list[Path]:
-    """cam.stl (and the other mesh formats): the plate, the groove cam's blank, or both plates of a pair."""
-    from camcad.export.mesh import build_groove_solid, build_solid, write_meshes
-
-    design, plate, formats = analysis.design, analysis.design.plate(), analysis.design.mesh.formats
-    groove, flanks = analysis.positive.groove, analysis.positive.flank_fits
-    if groove is not None and flanks is not None:
-        assert design.cam.outer_radius is not None  # required for a groove cam
-        solid = build_groove_solid(
-            flanks,
-            plate,
-            design.mesh,
-            outer_radius=design.cam.outer_radius,
-            depth=design.groove.depth,
-            cam=analysis.cam,
-            offsets=(groove.inner_offset, groove.outer_offset),
-        )
-        return write_meshes(folder, solid, formats)
-    out: list[Path] = []
-    for suffix, plate_cam, fit in _plates(analysis):
-        solid = build_solid(fit, plate, design.mesh, cam=plate_cam)
-        out += write_meshes(folder, solid, formats, stem=f"cam{suffix}")
-    return out
-
-
-def _write_steps(analysis: Analysis, folder: Path) -> list[Path]:
-    """cam.step: the plate, the groove cam's blank with its pocket, or both plates of a pair (cam_2.step)."""
-    from camcad.export.step import groove_body, write_cam_step, write_step
-
-    design, plate = analysis.design, analysis.design.plate()
-    flanks = analysis.positive.flank_fits
-    if analysis.positive.groove is not None and flanks is not None:
-        assert design.cam.outer_radius is not None  # required for a groove cam
-        body = groove_body(flanks, plate, outer_radius=design.cam.outer_radius, depth=design.groove.depth)
-        return [write_step(folder / "cam.step", [body])]
-    plates = _plates(analysis)
-    parts = range(1, 3) if len(plates) == 2 else (0,)  # a pair: named "plate 1"/"plate 2", placed as mounted
-    return [
-        write_cam_step(folder / f"cam{suffix}.step", fit=fit, plate=plate, part=part)
-        for (suffix, _, fit), part in zip(plates, parts, strict=True)
-    ]
+def _fitted(result: PartResult) -> ProfileFit:
+    """The certified fit of a made part's outline (build always fits)."""
+    assert result.fit is not None  # build analyses with the fit, and fails on a fit it cannot certify
+    return result.fit
 
 
 def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
     """motion.csv, profile.csv, dynamics.csv, points.csv, lift.csv and the optional tables into ``folder``."""
-    from camcad.export.tables import write_lift_csv, write_points_csv
+    from camcad.export.tables import (
+        write_dynamics_csv,
+        write_lift_csv,
+        write_motion_csv,
+        write_points_csv,
+        write_profile_csv,
+    )
 
-    cam, geo, design = analysis.cam, analysis.geometry, analysis.design
-    step = math.radians(MOTION_TABLE_STEP_DEG)
-    grid = np.arange(round(2 * math.pi / step)) * step
-    m = cam.motion(grid)
-    u = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
-    motion_csv = write_csv(
-        folder / "motion.csv",
-        {
-            "angle_deg": np.degrees(grid),
-            f"s_{u}": m.s,
-            f"v_{u}_per_rad": m.v,
-            f"a_{u}_per_rad2": m.a,
-            f"j_{u}_per_rad3": m.j,
-        },
-    )
-    profile_csv = write_csv(
-        folder / "profile.csv",
-        {
-            "angle_deg": np.degrees(geo.phi),
-            "pitch_x": geo.pitch.point[:, 0],
-            "pitch_y": geo.pitch.point[:, 1],
-            "x": geo.profile.point[:, 0],
-            "y": geo.profile.point[:, 1],
-            "nx": geo.profile.normal[:, 0],
-            "ny": geo.profile.normal[:, 1],
-            "pressure_angle_deg": np.degrees(geo.pressure_angle),
-            "rho_pitch_mm": geo.pitch.rho,
-            "rho_profile_mm": geo.profile.rho,
-        },
-    )
-    dyn = analysis.dynamics
-    dynamics_csv = write_csv(
-        folder / "dynamics.csv",
-        {
-            "angle_deg": np.degrees(dyn.phi),
-            "contact_force_N": dyn.contact_force,
-            "torque_Nmm": dyn.torque,
-            "hertz_stress_MPa": dyn.hertz_stress,
-            **(analysis.duty.csv_columns() if analysis.duty is not None else {}),
-        },
-    )
+    cam, design = analysis.cam, analysis.design
+    unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    duty = analysis.duty.csv_columns() if analysis.duty is not None else None  # life, film, drive columns
+    motion_csv = write_motion_csv(folder / "motion.csv", cam, unit=unit)
+    profile_csv = write_profile_csv(folder / "profile.csv", analysis.geometry)
+    dynamics_csv = write_dynamics_csv(folder / "dynamics.csv", analysis.dynamics, extra=duty)
     return [
         motion_csv,
         profile_csv,

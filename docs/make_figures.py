@@ -5,11 +5,17 @@
 - ``docs/oscillating.png``: the oscillating followers' convention at φ = 0,
   drawn from the follower modules of the two oscillating samples.
 - The Quintero & Vanegas (2016) section 5 table, printed as Markdown.
+- ``docs/report.png``: the top of ``report.html`` of ``samples/quintero_vap_b01.toml``
+  (the README's picture), built by ``camcad build --only report`` and shot by
+  headless Chromium (skipped, saying so, when ``chromium`` is not installed).
 """
 
 from __future__ import annotations
 
+import shutil
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -142,7 +148,24 @@ def oscillating_convention() -> None:
     fig.savefig(ROOT / "docs" / "oscillating.png")
 
 
+def report_page() -> None:
+    """Build the VAP sample's report and save a screenshot of its first screen (cam and key numbers)."""
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if browser is None:
+        print("docs/report.png not redrawn: no chromium on PATH", file=sys.stderr)
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "out"
+        sample = "samples/quintero_vap_b01.toml"  # relative: the report shows this path
+        build = [sys.executable, "-m", "camcad", "build", sample, "-o", str(out), "--only", "report", "-q"]
+        subprocess.run(build, check=True, cwd=ROOT, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+        shot = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars"]
+        shot += ["--window-size=1100,830", f"--screenshot={ROOT / 'docs' / 'report.png'}"]
+        subprocess.run([*shot, (out / "report.html").as_uri()], check=True, capture_output=True, timeout=120)
+
+
 if __name__ == "__main__":
+    report_page()
     oscillating_convention()
     hren_torque()
     quintero_table()

@@ -5,7 +5,7 @@ The layers are those of the README's architecture section, bottom first::
     shared bottom (_typing, _version, errors, angles, extremes, findings, roots, units)
       < motion < geometry < dynamics < inspect < fea < fit < toolpath < export
       < design
-      < analysis, positive, report, report_tables, _plots < pipeline < explore
+      < analysis, report, report_tables, _plots < pipeline < explore
       < cli, serve, api, __init__, __main__
 
 A module imports camcad code only from its own layer or below. The design
@@ -46,7 +46,7 @@ LAYER_ORDER: tuple[frozenset[str], ...] = (
     frozenset({"toolpath"}),  # camcad/toolpath/ (issue 13): the arc-spline tool paths
     frozenset({"export"}),
     frozenset({"design"}),  # the schema sits above every stage
-    frozenset({"analysis", "positive", "report", "report_tables", "_plots"}),
+    frozenset({"analysis", "report", "report_tables", "_plots"}),
     frozenset({"pipeline"}),
     frozenset({"explore"}),  # camcad/explore/ (issue 20): optimise, sweep, Pareto; analyses through pipeline
     # serve/ (issue 19): the live designer; api: the Python API (issue 39)
@@ -62,6 +62,20 @@ KNOWN_DESIGN_IMPORTS: dict[str, str] = {}
 # Import cycles, each as the sorted tuple of its modules. The list only shrinks: a new
 # cycle fails, and so does an entry whose cycle is gone. It is empty.
 KNOWN_CYCLES: dict[tuple[str, ...], str] = {}
+
+
+# A cam family (plate, groove, conjugate; barrel later) is one module under geometry/families/: no
+# code elsewhere asks which family a cam is. The files that still do are listed, each with its
+# reason; the list only shrinks (an entry whose branch is gone fails too). It is empty.
+FAMILY_HOME = PACKAGE / "geometry" / "families"
+FAMILY_BRANCH = re.compile(
+    r"CamStyle\.(?:GROOVE|CONJUGATE)\b"  # a family named by its enum member (PLATE is the default)
+    r"|(?:\bis|==|!=)\s*(?:not\s+)?CamStyle\.PLATE\b"
+    r"|\.style\s+(?:is|==|!=)"  # a family told apart by comparing the style
+    r"|\.style\.value\s*(?:==|!=)"
+    r"|\bcamcad\.positive\b|\bfrom\s+camcad\s+import\s+positive\b"  # the second pipeline, gone
+)
+KNOWN_FAMILY_BRANCHES: dict[str, str] = {}  # empty
 
 
 def _module_name(path: Path) -> str:
@@ -195,7 +209,46 @@ def test_no_new_import_cycle():
     assert not gone, f"these cycles are gone: remove them from KNOWN_CYCLES: {gone}"
 
 
+def family_branches(sources: Mapping[str, str]) -> dict[str, list[str]]:
+    """Each file (path from the root) and its lines that branch on a cam family."""
+    found: dict[str, list[str]] = {}
+    for name, text in sorted(sources.items()):
+        lines = [line.strip() for line in text.splitlines() if FAMILY_BRANCH.search(line)]
+        if lines:
+            found[name] = lines
+    return found
+
+
+def test_no_cam_family_branch_outside_its_module():
+    sources = {
+        p.relative_to(ROOT).as_posix(): p.read_text(encoding="utf-8")
+        for p in sorted(PACKAGE.rglob("*.py"))
+        if FAMILY_HOME not in p.parents
+    }
+    found = family_branches(sources)
+    new = {name: lines for name, lines in found.items() if name not in KNOWN_FAMILY_BRANCHES}
+    assert not new, f"cam-family branches belong in camcad/geometry/families/: {new}"
+    gone = sorted(KNOWN_FAMILY_BRANCHES.keys() - found.keys())
+    assert not gone, f"no longer branch on a cam family: remove them from KNOWN_FAMILY_BRANCHES: {gone}"
+
+
 # The checks themselves, on made-up modules: they must be able to fail.
+
+
+def test_family_rule_flags_branches_and_the_second_pipeline():
+    sources = {
+        "camcad/a.py": "if design.cam.style is CamStyle.GROOVE:\n    pass\n",
+        "camcad/b.py": "from camcad.positive import analyse_positive_drive\n",
+        "camcad/c.py": "ok = spec.style.value == 'plate'\nx = CamStyle.CONJUGATE\n",
+        "camcad/d.py": "family = family_of(design.cam.style)  # the registry: no branch\n",
+        "camcad/e.py": "style: CamStyle = CamStyle.PLATE\nif cam.style is not CamStyle.PLATE:\n",
+    }
+    assert family_branches(sources) == {
+        "camcad/a.py": ["if design.cam.style is CamStyle.GROOVE:"],
+        "camcad/b.py": ["from camcad.positive import analyse_positive_drive"],
+        "camcad/c.py": ["ok = spec.style.value == 'plate'", "x = CamStyle.CONJUGATE"],
+        "camcad/e.py": ["if cam.style is not CamStyle.PLATE:"],
+    }
 
 
 def _imports_of(source: str, module: str = "camcad.motion.laws", known: Iterable[str] = ()) -> set[str]:

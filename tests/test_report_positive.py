@@ -34,8 +34,7 @@ def _centres(drawings) -> np.ndarray:
 
 def test_second_rollers_are_drawn_on_the_second_plate() -> None:
     analysis = analysed("indexing_conjugate.toml")
-    partner = analysis.positive.partner
-    assert partner is not None
+    partner = analysis.parts[1].part.cam
     drawings = follower_drawings(analysis, 100.0, cam=partner)
     plate = partner.profile(DENSE).point
     gap = distance_to_polygon(_centres(drawings), plate)
@@ -58,3 +57,13 @@ def test_groove_rollers_are_drawn_in_the_groove() -> None:
     for flank in (inner, outer):
         assert np.abs(distance_to_polygon(centres, flank.point) - half).max() < 1e-3
     assert b"groove flanks" in profile_plot(analysis).svg
+
+
+def test_dynamics_plot_draws_the_second_plate_force_and_stress() -> None:
+    """Issue 31: a conjugate pair's dynamics figure carries plate 2's own force and stress series."""
+    from camcad._plots.design import dynamics_plot
+
+    pair = dynamics_plot(analysed("indexing_conjugate.toml")).svg
+    single = dynamics_plot(analysed("offset_roller.toml")).svg
+    assert pair.count(b"plate 2") >= 2 and pair.count(b"plate 1") >= 2  # legend of force and of stress
+    assert b"plate 2" not in single

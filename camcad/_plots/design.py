@@ -35,6 +35,7 @@ from camcad.geometry.envelope import to_cam
 if TYPE_CHECKING:
     from camcad.analysis import Analysis
     from camcad.geometry.cam import Cam
+    from camcad.geometry.families import Pocket
 
 __all__ = [
     "CURVATURE_CLIP",
@@ -190,12 +191,21 @@ def dynamics_plot(analysis: Analysis) -> Plot:
     stress_lines = [] if spec.allowable_stress is None else [
         HLine(y=spec.allowable_stress, label=f"allowable {spec.allowable_stress:g} MPa")
     ]  # fmt: skip
+    # a conjugate pair: the second plate's own force and stress (its roller, its dynamics), same code
+    later = [r.dynamics for r in analysis.parts[1:]]  # every further part (a pair's second plate), same code
+    one = "plate 1" if later else ""
+    force = [_curve(phi, dyn.contact_force, COLORS[4], label=one)]
+    stress = [_curve(phi, dyn.hertz_stress, COLORS[6], label=one)]
+    for i, dyn2 in enumerate(later, start=2):
+        phi2 = np.degrees(np.asarray(dyn2.phi))
+        force.append(_curve(phi2, dyn2.contact_force, COLORS[1], label=f"plate {i}"))
+        stress.append(_curve(phi2, dyn2.hertz_stress, COLORS[1], label=f"plate {i}"))
     panels = [
-        Panel(ylabel="contact force\nF [N]", series=[_curve(phi, dyn.contact_force, COLORS[4])],
-              lines=force_lines, legend=bool(force_lines), height=130.0),
+        Panel(ylabel="contact force\nF [N]", series=force,
+              lines=force_lines, legend=bool(force_lines) or bool(later), height=130.0),
         Panel(ylabel="input torque\nT [N·mm]", series=[_curve(phi, dyn.torque, COLORS[5])], height=130.0),
-        Panel(ylabel="Hertz stress\nσ [MPa]", series=[_curve(phi, dyn.hertz_stress, COLORS[6])],
-              lines=stress_lines, legend=bool(stress_lines), height=130.0),
+        Panel(ylabel="Hertz stress\nσ [MPa]", series=stress,
+              lines=stress_lines, legend=bool(stress_lines) or bool(later), height=130.0),
     ]  # fmt: skip
     bounds_deg, _ = _segments(analysis)
     return Plot(
@@ -297,27 +307,26 @@ SECOND_PLATE = "#b5651d"
 """Outline colour of a conjugate pair's second plate."""
 
 
-def _draw_groove(ax: Axes, analysis: Analysis, outer_radius: float) -> None:
-    """A groove cam seen from its face: the blank, the groove between its flanks (white), the flanks."""
-    groove, phi = analysis.positive.groove, analysis.geometry.phi
-    assert groove is not None
-    cam = analysis.cam
-    inner = np.asarray(cam.offset(phi, groove.inner_offset).point)
-    outer = np.asarray(cam.offset(phi, groove.outer_offset).point)
-    shape(ax, Circle((0.0, 0.0), outer_radius, facecolor="#dbe6f1", edgecolor="#1f3b57", linewidth=1.2))
+def _draw_pocket(ax: Axes, analysis: Analysis, pocket: Pocket) -> None:
+    """A part with a pocket seen from its face: the blank, the pocket (white) between its flanks."""
+    cam, phi = analysis.cam, analysis.geometry.phi
+    inner, outer = (np.asarray(cam.offset(phi, flank.offset).point) for flank in pocket.flanks)
+    shape(
+        ax, Circle((0.0, 0.0), pocket.outer_radius, facecolor="#dbe6f1", edgecolor="#1f3b57", linewidth=1.2)
+    )
     shape(ax, Polygon(outer, closed=True, facecolor="white", edgecolor="#1f3b57", linewidth=1.5))
     shape(ax, Polygon(inner, closed=True, facecolor="#dbe6f1", edgecolor="#1f3b57", linewidth=1.5))
-    ax.plot([], [], color="#1f3b57", linewidth=1.5, label=f"groove flanks ({groove.width:.3f} mm wide)")
+    ax.plot([], [], color="#1f3b57", linewidth=1.5, label=f"groove flanks ({pocket.width:.3f} mm wide)")
 
 
-def _positive_caption(analysis: Analysis) -> str:
-    """What the cam drawing adds for a groove or a conjugate pair, as a sentence (or nothing)."""
-    positive = analysis.positive
-    if positive.groove is not None:
-        return " The roller runs in the groove milled into the blank's face."
-    if positive.partner is not None and positive.second_plate:
-        return f" The second plate (outline) drives the {positive.partner.kinematics.describe()}."
-    return ""
+def family_caption(analysis: Analysis) -> str:
+    """What the cam drawing adds for the cam's family (a groove, a pair's second plate), as a sentence."""
+    return analysis.family.caption([r.part for r in analysis.parts])
+
+
+def further_plates(analysis: Analysis) -> list[Cam]:
+    """The cams of the family's further plates to draw behind the first (a pair's second plate)."""
+    return [r.part.cam for r in analysis.parts[1:] if r.part.made and r.part.pocket is None]
 
 
 def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
@@ -326,19 +335,19 @@ def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
     profile = np.asarray(geo.profile.point)
     pitch = np.asarray(geo.pitch.point)
     reach = float(max(np.hypot(*pitch.T).max() + cam.roller_radius, np.hypot(*profile.T).max()))
-    positive = analysis.positive
-    if positive.groove is not None and spec.outer_radius is not None:
-        reach = max(reach, spec.outer_radius)
+    pocket = analysis.parts[0].part.pocket
+    if pocket is not None:
+        reach = max(reach, pocket.outer_radius)
     fig = figure((size, size), left=0.7, bottom=0.5, top=0.15, right=0.15)
     ax = fig.subplots()
-    if positive.groove is not None and spec.outer_radius is not None:
-        _draw_groove(ax, analysis, spec.outer_radius)
+    if pocket is not None:
+        _draw_pocket(ax, analysis, pocket)
     else:
         shape(ax, Polygon(profile, closed=True, facecolor="#dbe6f1", edgecolor="#1f3b57", linewidth=1.5))
         ax.plot([], [], color="#1f3b57", linewidth=1.5, label="cam profile")
-    partner = positive.partner if positive.second_plate else None
-    if partner is not None:
-        second = np.asarray(partner.profile(geo.phi).point)
+    further = further_plates(analysis)
+    for plate in further:
+        second = np.asarray(plate.profile(geo.phi).point)
         reach = max(reach, float(np.hypot(*second.T).max()))
         shape(ax, Polygon(second, closed=True, fill=False, edgecolor=SECOND_PLATE, linewidth=1.5))
         ax.plot([], [], color=SECOND_PLATE, linewidth=1.5, label="second plate (behind)")
@@ -356,8 +365,8 @@ def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
     ax.plot([-tick, tick], [0.0, 0.0], color="black", linewidth=0.8)
     ax.plot([0.0, 0.0], [-tick, tick], color="black", linewidth=0.8)
     far = _draw_followers(ax, analysis, reach)
-    if partner is not None:
-        far = max(far, _draw_followers(ax, analysis, reach, cam=partner))
+    for plate in further:
+        far = max(far, _draw_followers(ax, analysis, reach, cam=plate))
     # direction of rotation, as an arc just outside the profile
     sign = 1.0 if cam.rotation.value == "ccw" else -1.0
     r_arrow = 1.08 * float(np.hypot(*profile.T).max())
@@ -381,6 +390,6 @@ def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
         f"{cam.kinematics.describe()}, drawn where it meets the cam at φ = "
         + ", ".join(f"{a:g}°" for a in FOLLOWER_ANGLES_DEG)
         + " (kinematic inversion)."
-        + _positive_caption(analysis),
+        + family_caption(analysis),
         svg=svg(fig),
     )

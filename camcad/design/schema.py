@@ -47,6 +47,7 @@ from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec, PlaneModel
 from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import Cam
+from camcad.geometry.families import FAMILIES, FamilyOptions, family_of
 from camcad.geometry.followers import (
     DEFAULT_FOLLOWER,
     FOLLOWER_TYPES,
@@ -55,7 +56,6 @@ from camcad.geometry.followers import (
     follower_keys,
 )
 from camcad.geometry.followers.base import KeyRange
-from camcad.geometry.limits import conjugate_overlap
 from camcad.geometry.sensitivity import Tol
 from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
 from camcad.motion._blendlaws import MAX_POLYNOMIAL_DEGREE
@@ -1084,36 +1084,18 @@ def _lift_profile(segments: tuple[SegmentSpec, ...]) -> list[float]:
 
 
 def _check_style(design: Design) -> None:
-    """Groove and conjugate cams drive rollers; a groove needs its blank and fits in it."""
+    """The cam family's own checks (a groove's blank); positive drive needs a roller follower."""
     cam, fol = design.cam, design.follower
-    if cam.style is CamStyle.PLATE:
-        if cam.outer_radius is not None:
-            raise DesignError("cam.outer_radius", "applies to groove cams (cam.style = 'groove') only")
-        return
-    if not fol.kind.two_sided:
-        raise DesignError(
-            "cam.style", f"a {cam.style.value} cam needs a roller follower, not {fol.kind.word}"
-        )
-    if cam.style is CamStyle.GROOVE:
-        if cam.outer_radius is None:
-            raise DesignError("cam.outer_radius", "is required for a groove cam (mm, the blank's radius)")
-        if cam.outer_radius <= cam.base_radius + 2.0 * fol.roller_radius:
-            raise DesignError(
-                "cam.outer_radius",
-                f"{cam.outer_radius:g} mm leaves no room for the groove; allowed: > base_radius + 2 × "
-                f"roller_radius = {cam.base_radius + 2.0 * fol.roller_radius:g} mm",
-            )
-        if design.groove.depth >= cam.thickness:
-            raise DesignError(
-                "groove.depth",
-                f"{design.groove.depth:g} mm must be less than the blank's thickness {cam.thickness:g} mm",
-            )
-    if cam.style is CamStyle.CONJUGATE and design.conjugate.single_plate:
+    family = family_of(cam.style)
+    if family.needs_roller and not fol.kind.two_sided:
+        raise DesignError("cam.style", f"a {family.name} cam needs a roller follower, not {fol.kind.word}")
+    options = FamilyOptions(groove=design.groove, conjugate=design.conjugate, outer_radius=cam.outer_radius)
+    family.check(
+        options, base_radius=cam.base_radius, roller_radius=fol.roller_radius, thickness=cam.thickness
+    )
+    if options.conjugate.single_plate:  # only a [conjugate] table sets it, and only a pair may have one
         _check_constant_breadth(design)
-    if cam.style is CamStyle.CONJUGATE:
-        problem = conjugate_overlap(Cam.from_design(design).partner(design.conjugate))
-        if problem is not None:
-            raise DesignError(*problem)
+    family.check_cam(lambda: Cam.from_design(design), options)  # a pair's rollers must clear each other
 
 
 def _check_constant_breadth(design: Design) -> None:
@@ -1229,7 +1211,7 @@ def _check_fea(design: Design) -> None:
     from camcad.fea.mesh import MAX_ELEMENTS, estimated_triangles, smallest_mesh_size
     from camcad.fea.model import keyway_fillet
 
-    if design.cam.style is not CamStyle.PLATE:
+    if not family_of(design.cam.style).one_plate:
         style = design.cam.style.value
         raise DesignError("fea", f"the finite-element check applies to cam.style = 'plate' only, not {style}")
     bore = design.plate().bore
@@ -1260,7 +1242,7 @@ def _check_gcode(design: Design) -> None:
             "'grbl' cannot run a rotary program (no rotary axis, no G93 inverse-time feed); "
             "allowed with machine = 'rotary': linuxcnc, generic",
         )
-    if gc.machine is Machine.ROTARY and cam.style is not CamStyle.PLATE:
+    if gc.machine is Machine.ROTARY and not family_of(cam.style).one_plate:
         raise DesignError(
             "gcode.machine", f"'rotary' cuts a plate cam's outline, not a {cam.style.value} cam (allowed: xy)"
         )
@@ -1380,8 +1362,10 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
     specs |= _service_tables(data)  # [life], [lubrication], [drive] (issue 35)
     if "vibration" in data:  # issue 34
         specs["vibration"] = VibrationSpec(**_section("vibration", data["vibration"]))
-    for table in ("groove", "conjugate"):  # after their values, so a bad value names its own key
-        if table in data and specs["cam"].style.value != table:
+    own = family_of(specs["cam"].style).table
+    for family in FAMILIES.values():  # after their values, so a bad value names its own key
+        table = family.table
+        if table is not None and table in data and table != own:
             raise DesignError(table, f"the [{table}] table applies to cam.style = '{table}' only")
     follower = specs["follower"]
     _check_follower_keys(follower.kind, data.get("follower", {}), data.get("dynamics", {}))

@@ -23,7 +23,7 @@ from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec
 from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import follower_from_spec
-from camcad.geometry.groove import roller_flank_offsets
+from camcad.geometry.families import FamilyOptions, family_of
 from camcad.geometry.plate import BoreOutline, Plate
 from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
 from camcad.motion.segments import SegmentSpec
@@ -89,6 +89,16 @@ class Design:
             bore=BoreOutline.from_cam_spec(cam.bore, cam.keyway_width, cam.keyway_depth),
         )
 
+    def family_options(self) -> FamilyOptions:
+        """What the cam families read: ``[groove]``, ``[conjugate]``, the blank, the bore's reach."""
+        bore = self.plate().bore
+        return FamilyOptions(
+            groove=self.groove,
+            conjugate=self.conjugate,
+            outer_radius=self.cam.outer_radius,
+            hole_radius=0.0 if bore is None else bore.reach,
+        )
+
     def dynamics_setup(self) -> DynamicsSetup:
         """The dynamics stage's options: ``[dynamics]`` with the speed and contact geometry it uses."""
         dyn, cam, fol = self.dynamics, self.cam, self.follower
@@ -102,11 +112,7 @@ class Design:
             # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
             tappet_offset=fol.eccentricity if cam.rotation is Rotation.CCW else -fol.eccentricity,
             arm_angle=module.arm_direction,
-            positive_drive=cam.style is not CamStyle.PLATE,
-            clearance=self.groove.clearance if cam.style is CamStyle.GROOVE else 0.0,
-            flank_offsets=roller_flank_offsets(fol.roller_radius, self.groove.clearance)
-            if cam.style is CamStyle.GROOVE
-            else None,
+            **family_of(cam.style).drive(fol.roller_radius, self.family_options()),
         )
 
     def with_base_radius(self, base_radius: float) -> Design:

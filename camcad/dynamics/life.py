@@ -399,7 +399,7 @@ def track_life(
     the largest K.
     """
     if spec.track is None:
-        raise DesignError("life.track_material", "is needed for the track's life")
+        raise DesignError("life.track_slope", "is needed for the track's life")
     p = np.asarray(phi, dtype=float).ravel()
     k = load_stress_factor(force, curvature=curvature, length=length)
     i = int(np.argmax(k))
@@ -459,7 +459,7 @@ def life_findings(
             Finding(
                 kind="track life",
                 severity=Severity.SOFT,
-                field="life.track_material",
+                field="life.track_slope",
                 message=(
                     f"cam track surface-fatigue life {track.hours:.4g} h (load-stress factor "
                     f"{track.factor_max:.4g} MPa at {math.degrees(track.angle):.1f}°) is below the required "

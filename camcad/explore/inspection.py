@@ -240,11 +240,11 @@ def _compensated_files(
 ) -> tuple[str, Any, CompensatedCam, dict[str, Any]]:
     """The corrected program's text, the fit for its DXF, the corrected cam and the figures."""
     from camcad.fit import fit_cam_profile
-    from camcad.geometry.spec import CamStyle
+    from camcad.geometry.families import family_of
     from camcad.toolpath import plan_toolpath
     from camcad.toolpath.spec import Machine
 
-    if design.cam.style is not CamStyle.PLATE or design.gcode.machine is Machine.ROTARY:
+    if not family_of(design.cam.style).one_plate or design.gcode.machine is Machine.ROTARY:
         raise UsageError("--stock", "compensation mills a plate cam's outside profile on an XY machine only")
     spec = dataclasses.replace(design.gcode, tool_diameter=tool_diameter)
     comp = compensate(cam, act.form, stock=stock, tool_radius=spec.tool_radius)

@@ -348,6 +348,7 @@ class _Evaluator:
         return self.cache[physical]
 
     def _evaluate(self, physical: tuple[float, ...]) -> _Point:
+        from camcad.geometry.groove import GrooveAnalysis
         from camcad.geometry.sizing import feasible_margins
         from camcad.pipeline import analyse
 
@@ -359,10 +360,7 @@ class _Evaluator:
             return _Point({}, {}, -math.inf, 1.0, (str(err),), False)
         summary = analysis.summary()
         measures = measure_values(analysis, summary)
-        drive = analysis.positive
-        plates = [(analysis.cam, analysis.geometry.phi)]
-        if drive.partner is not None and drive.partner_geometry is not None:
-            plates.append((drive.partner, drive.partner_geometry.phi))  # a conjugate pair's second plate
+        plates = [(r.part.cam, r.geometry.phi) for r in analysis.parts]  # every part: a pair's second plate
         signed = [_signed_pressure_deg(cam, phi) for cam, phi in plates]
         pieces: dict[str, tuple[float, ...]] = {
             "pressure_angle": (max(hi for hi, _ in signed), -min(lo for _, lo in signed))
@@ -376,11 +374,12 @@ class _Evaluator:
             analysis.geometry.phi,
             max_pressure_angle=math.pi / 2,
             min_curvature_radius=design.min_curvature_radius,
-            conjugate=None if drive.partner is None else drive.partner.conjugate,
+            conjugate=analysis.parts[-1].part.cam.conjugate,  # a pair's second plate's; else None
         )
-        if drive.groove is not None:  # a groove's flanks loop where their radius reaches 0 (a hard limit)
-            flanks = (drive.groove.inner_convex_min, drive.groove.outer_concave_min)
-            rho_margin = min([rho_margin, *(f.value for f in flanks if f is not None)])
+        for check in (c for r in analysis.parts for c in r.part.checks):
+            if isinstance(check, GrooveAnalysis):  # the flanks loop where their radius reaches 0 (hard)
+                flanks = (check.inner_convex_min, check.outer_concave_min)
+                rho_margin = min([rho_margin, *(f.value for f in flanks if f is not None)])
         findings = tuple(f.message for f in analysis.findings)
         return _Point(measures, pieces, float(rho_margin), max(design.cam.base_radius, 1.0), findings, True)
 

@@ -107,6 +107,7 @@ from camcad.toolpath.arcs.biarc import Pieces
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
+    from camcad.geometry.families import Part
 
 __all__ = [
     "DXF_VERSION",
@@ -117,6 +118,7 @@ __all__ = [
     "profile_arcs_document",
     "profile_document",
     "profile_poly_document",
+    "write_part_dxfs",
     "write_profile_arcs_dxf",
     "write_profile_dxf",
     "write_profile_poly_dxf",
@@ -629,3 +631,43 @@ def _writer(build: Callable[..., Drawing], name: str) -> Callable[..., Path]:
 write_profile_dxf = _writer(profile_document, "profile")
 write_profile_arcs_dxf = _writer(profile_arcs_document, "profile_arcs")
 write_profile_poly_dxf = _writer(profile_poly_document, "profile_poly")
+
+
+def write_part_dxfs(
+    folder: str | os.PathLike[str],
+    part: Part,
+    *,
+    fit: ProfileFit,
+    flank_fits: Sequence[ProfileFit] = (),
+    plate: Plate,
+    options: DxfSpec,
+) -> list[Path]:
+    """``profile{suffix}.dxf``, ``profile_poly{suffix}.dxf`` and ``profile_arcs{suffix}.dxf`` of one part.
+
+    A part with a pocket is drawn as its blank (``BLANK``) with the pocket's
+    flanks (their fits ``flank_fits``, on the flanks' layers); a plate as its outline.
+    """
+    curves: tuple[DxfCurve, ...] | None = None
+    blank_radius: float | None = None
+    if part.pocket is not None:
+        curves = tuple(
+            DxfCurve(layer=flank.layer, fit=flank_fit, offset=flank.offset)
+            for flank, flank_fit in zip(part.flanks, flank_fits, strict=True)
+        )
+        blank_radius = part.pocket.outer_radius
+    return [
+        write(
+            Path(folder) / f"{name}{part.suffix}.dxf",
+            cam=part.cam,
+            fit=fit,
+            plate=plate,
+            options=options,
+            curves=curves,
+            blank_radius=blank_radius,
+        )
+        for name, write in (
+            ("profile", write_profile_dxf),
+            ("profile_poly", write_profile_poly_dxf),
+            ("profile_arcs", write_profile_arcs_dxf),
+        )
+    ]

@@ -75,6 +75,7 @@ from camcad.geometry.plate import BoreOutline, Plate, circle_segments
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
+    from camcad.geometry.families import Part
 
 __all__ = [
     "MESH_FORMATS",
@@ -86,6 +87,7 @@ __all__ = [
     "build_solid",
     "threemf_bytes",
     "write_meshes",
+    "write_part_meshes",
 ]
 
 MESH_FORMATS = ("stl", "obj", "ply", "off", "3mf", "vtu")
@@ -480,3 +482,37 @@ def write_meshes(
             atomic_write_bytes(path, _encoded(solid.mesh, fmt, stem))
         written.append(path)
     return written
+
+
+def write_part_meshes(
+    outdir: str | os.PathLike[str],
+    part: Part,
+    *,
+    fit: ProfileFit,
+    flank_fits: Sequence[ProfileFit] = (),
+    plate: Plate,
+    options: MeshSpec,
+    formats: Sequence[str] = ("stl",),
+) -> list[Path]:
+    """``cam{suffix}.stl`` (and the other formats) of one part: its blank with the pocket, or its plate.
+
+    A part with a pocket is the blank less the pocket between its flanks'
+    fits ``flank_fits`` (:func:`build_groove_solid`); a plate is its outline
+    ``fit`` extruded (:func:`build_solid`).
+    """
+    solid: SolidResult | GrooveSolidResult
+    if part.pocket is not None:
+        inner, outer = flank_fits
+        first, second = part.pocket.flanks
+        solid = build_groove_solid(
+            (inner, outer),
+            plate,
+            options,
+            outer_radius=part.pocket.outer_radius,
+            depth=part.pocket.depth,
+            cam=part.cam,
+            offsets=(first.offset, second.offset),
+        )
+    else:
+        solid = build_solid(fit, plate, options, cam=part.cam)
+    return write_meshes(outdir, solid, formats, stem=f"cam{part.suffix}")

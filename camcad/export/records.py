@@ -14,7 +14,7 @@ import numpy as np
 from camcad._typing import ArrayLike
 from camcad.export.atomic import atomic_write_text
 
-__all__ = ["csv_text", "write_csv", "write_json", "write_text"]
+__all__ = ["csv_text", "json_safe", "write_csv", "write_json", "write_text"]
 
 CSV_FORMAT = "{:.9g}"
 """Default cell format, nine significant digits: sub-micrometre on a 1 m cam, stable for diffs."""
@@ -70,6 +70,15 @@ def _clean(value: Any) -> Any:
     if isinstance(value, np.bool_):
         return bool(value)
     return value
+
+
+def json_safe(value: Any) -> Any:
+    """``value`` as ``summary.json`` writes it: numpy values as Python ones, non-finite floats as None.
+
+    A None where a number belongs means "no finite value" (an unbounded end, e.g. the
+    upper end of a jump-free speed range with no upper limit).
+    """
+    return _clean(value)
 
 
 def write_json(path: str | os.PathLike[str], data: Mapping[str, Any]) -> Path:

@@ -50,6 +50,7 @@ from camcad.geometry.plate import BoreOutline
 
 if TYPE_CHECKING:
     from camcad.fit.result import ProfileFit
+    from camcad.geometry.families import Part
     from camcad.geometry.plate import Plate
 
 __all__ = [
@@ -62,6 +63,7 @@ __all__ = [
     "plate_body",
     "step_text",
     "write_cam_step",
+    "write_part_step",
     "write_step",
 ]
 
@@ -229,3 +231,27 @@ def write_step(path: str | os.PathLike[str], bodies: Sequence[Body]) -> Path:
 def write_cam_step(path: str | os.PathLike[str], *, fit: ProfileFit, plate: Plate, part: int = 0) -> Path:
     """Write ``cam.step``: the plate of :func:`plate_body` as one solid (``part``: a pair's plate 1 or 2)."""
     return write_step(path, [plate_body(fit, plate, part=part)])
+
+
+def write_part_step(
+    folder: str | os.PathLike[str],
+    part: Part,
+    *,
+    fit: ProfileFit,
+    flank_fits: Sequence[ProfileFit] = (),
+    plate: Plate,
+    number: int = 0,
+) -> Path:
+    """``cam{suffix}.step`` of one part: its blank with the pocket, or its plate.
+
+    ``number``: the part's place in a family that makes several (1, 2, …,
+    named and placed as mounted, :func:`plate_body`), 0 for a family's only part.
+    """
+    path = Path(folder) / f"cam{part.suffix}.step"
+    if part.pocket is not None:
+        inner, outer = flank_fits
+        body = groove_body(
+            (inner, outer), plate, outer_radius=part.pocket.outer_radius, depth=part.pocket.depth
+        )
+        return write_step(path, [body])
+    return write_cam_step(path, fit=fit, plate=plate, part=number)

@@ -1,4 +1,11 @@
-"""CSV tables for inspection and rotary grinding: ``points.csv`` and ``lift.csv``.
+"""CSV tables: motion, profile and dynamics; ``points.csv`` and ``lift.csv`` for inspection and grinding.
+
+``motion.csv``: s, v, a, j per cam angle on a 0.1° grid (``MOTION_TABLE_STEP_DEG``),
+in the lift's unit (mm on a slide, degrees of swing on an arm) per radian;
+``profile.csv``: the pitch curve, the profile with its outward normal, the
+pressure angle and both radii of curvature at the geometry's angles;
+``dynamics.csv``: contact force, torque and Hertz stress at the dynamics'
+angles, with any further columns the duty stages add.
 
 Both tables use one uniform angle grid: n = ⌈2π / ``[tables].step``⌉ rows at
 angles 2πi/n, so the grid closes the turn exactly (the step is shrunk
@@ -58,18 +65,27 @@ from camcad.geometry.spec import Rotation
 from camcad.geometry.tool import check_tool
 
 if TYPE_CHECKING:
+    from camcad.dynamics.results import DynamicsResult
     from camcad.geometry.cam import Cam
+    from camcad.geometry.limits import GeometryAnalysis
 
 __all__ = [
     "LIFT_HEADER",
+    "MOTION_TABLE_STEP_DEG",
     "POINTS_HEADER",
     "polar_radius",
     "polar_table_text",
     "table_angles",
+    "write_dynamics_csv",
     "write_lift_csv",
+    "write_motion_csv",
     "write_points_csv",
     "write_polar_table",
+    "write_profile_csv",
 ]
+
+MOTION_TABLE_STEP_DEG = 0.1
+"""The angle step of ``motion.csv`` [deg]."""
 
 POINTS_HEADER = "cam_angle_deg,x_mm,y_mm,normal_x,normal_y,radius_of_curvature_mm"
 LIFT_HEADER = "angle_deg,lift_mm,polar_radius_mm"
@@ -288,3 +304,52 @@ def polar_table_text(cam: Cam, options: TablesSpec, *, name: str = "") -> str:
 def write_polar_table(path: str | os.PathLike[str], cam: Cam, options: TablesSpec, *, name: str = "") -> Path:
     """Write ``polar.txt`` (see :func:`polar_table_text`) atomically; return its path."""
     return write_text(path, polar_table_text(cam, options, name=name))
+
+
+def write_motion_csv(path: str | os.PathLike[str], cam: Cam, *, unit: str) -> Path:
+    """``motion.csv``: angle_deg, then s, v, a, j in ``unit`` (mm or deg) per rad^k, every 0.1°."""
+    step = math.radians(MOTION_TABLE_STEP_DEG)
+    grid = np.arange(round(2 * math.pi / step)) * step
+    m = cam.motion(grid)
+    u = unit
+    columns = {
+        "angle_deg": np.degrees(grid),
+        f"s_{u}": m.s,
+        f"v_{u}_per_rad": m.v,
+        f"a_{u}_per_rad2": m.a,
+        f"j_{u}_per_rad3": m.j,
+    }
+    return write_csv(path, columns)
+
+
+def write_profile_csv(path: str | os.PathLike[str], geometry: GeometryAnalysis) -> Path:
+    """``profile.csv``: pitch curve, profile, outward normal, pressure angle [deg], radii [mm] per angle."""
+    geo = geometry
+    columns = {
+        "angle_deg": np.degrees(geo.phi),
+        "pitch_x": geo.pitch.point[:, 0],
+        "pitch_y": geo.pitch.point[:, 1],
+        "x": geo.profile.point[:, 0],
+        "y": geo.profile.point[:, 1],
+        "nx": geo.profile.normal[:, 0],
+        "ny": geo.profile.normal[:, 1],
+        "pressure_angle_deg": np.degrees(geo.pressure_angle),
+        "rho_pitch_mm": geo.pitch.rho,
+        "rho_profile_mm": geo.profile.rho,
+    }
+    return write_csv(path, columns)
+
+
+def write_dynamics_csv(
+    path: str | os.PathLike[str], dynamics: DynamicsResult, *, extra: dict[str, FloatArray] | None = None
+) -> Path:
+    """``dynamics.csv``: contact force [N], torque [N·mm], Hertz stress [MPa], then ``extra``'s columns."""
+    dyn = dynamics
+    columns = {
+        "angle_deg": np.degrees(dyn.phi),
+        "contact_force_N": dyn.contact_force,
+        "torque_Nmm": dyn.torque,
+        "hertz_stress_MPa": dyn.hertz_stress,
+        **(extra or {}),
+    }
+    return write_csv(path, columns)

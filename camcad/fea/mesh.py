@@ -51,7 +51,7 @@ _GMSH_LOCK = threading.Lock()  # gmsh keeps one global model: one mesh at a time
 MAX_ELEMENTS = 30_000
 """Most triangles a plate mesh may have, estimated before meshing (:func:`estimated_triangles`).
 
-Measured (README, "Hard and soft limits"): the test plate at 47 000 P2
+Measured (docs/reference/commands.md, "Hard and soft limits"): the test plate at 47 000 P2
 triangles took 74 s to mesh and solve its load cases on a shared 2-core
 machine, at 7 300 triangles 5.5 s; 30 000 keeps a check under about a minute.
 """

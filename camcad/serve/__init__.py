@@ -14,7 +14,7 @@ Modules: ``form`` (fields from the schema, values back to a design mapping, TOML
 ``payload`` (the JSON the page draws), ``page`` (HTML, CSS, script),
 ``toml_edit`` (Save: only the changed keys, comments kept), ``app`` (the
 server: loopback only, a per-run token, same-origin POSTs, bounded threads;
-see its docstring and "Security of camcad serve" in the README).
+see its docstring and docs/reference/serve-security.md).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 The standard library's HTTP machinery is enough for one user on one machine
 and adds no dependency; what a server on a workstation must not allow is
-handled here (see "Security of camcad serve" in the README):
+handled here (see docs/reference/serve-security.md):
 
 - it listens on 127.0.0.1 only, and answers only requests addressed to a
   loopback name (``Host``: no DNS rebinding from a web page);
@@ -72,6 +72,7 @@ from urllib.parse import parse_qs, urlsplit
 
 from camcad.design import load_design, parse_design
 from camcad.errors import CamcadError, DesignError, UsageError
+from camcad.export.records import json_safe
 from camcad.serve.form import design_data, form_groups
 from camcad.serve.page import STATIC, render_page
 from camcad.serve.payload import evaluate
@@ -501,7 +502,9 @@ class _Handler(BaseHTTPRequestHandler):
             self.wfile.write(body)
 
     def _json(self, status: int, data: Any) -> None:
-        self._send(status, json.dumps(data, allow_nan=False).encode("utf-8"), "application/json")
+        # non-finite numbers as null, as summary.json writes them (camcad.export.records.json_safe)
+        body = json.dumps(json_safe(data), allow_nan=False)
+        self._send(status, body.encode("utf-8"), "application/json")
 
     def _refuse(self, status: int, message: str, extra: Mapping[str, str] | None = None) -> None:
         self.close_connection = True

@@ -20,7 +20,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from camcad._plots._base import trace_name
-from camcad._plots.design import CURVATURE_CLIP, _positive_caption, bore_outline, follower_drawings
+from camcad._plots.design import (
+    CURVATURE_CLIP,
+    bore_outline,
+    family_caption,
+    follower_drawings,
+)
 from camcad.design import parse_design
 from camcad.errors import CamcadError, DesignError
 from camcad.pipeline import analyse
@@ -74,25 +79,19 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
     profile = np.asarray(geo.profile.point)
     pitch = np.asarray(geo.pitch.point)
     reach = float(max(np.hypot(*pitch.T).max() + cam.roller_radius, np.hypot(*profile.T).max()))
-    positive = analysis.positive
+    pocket = analysis.parts[0].part.pocket
     groove = None
-    if positive.groove is not None and spec.outer_radius is not None:  # as the report draws it
-        g, phi = positive.groove, geo.phi
-        groove = {
-            "outer_radius": spec.outer_radius,
-            "inner": _xy(cam.offset(phi, g.inner_offset).point),
-            "outer": _xy(cam.offset(phi, g.outer_offset).point),
-            "width": g.width,
-        }
+    if pocket is not None:  # as the report draws it
+        inner, outer = (_xy(cam.offset(geo.phi, flank.offset).point) for flank in pocket.flanks)
+        groove = {"outer_radius": pocket.outer_radius, "inner": inner, "outer": outer, "width": pocket.width}
     second = None
-    partner = positive.partner if positive.second_plate else None
-    if partner is not None:
-        plate = positive.partner_geometry  # its profile on the same grid, as analysed: not evaluated again
-        same = plate is not None and np.array_equal(plate.phi, geo.phi)
-        outline = np.asarray(
-            plate.profile.point if same and plate is not None else partner.profile(geo.phi).point
-        )
-        second = {"profile": _xy(outline), "followers": _followers(analysis, reach, partner)}
+    for result in analysis.parts[1:]:  # a pair's second plate
+        if not result.part.made or result.part.pocket is not None:
+            continue
+        plate, later = result.part.cam, result.geometry  # its profile on the same grid, as analysed
+        same = np.array_equal(later.phi, geo.phi)
+        outline = np.asarray(later.profile.point if same else plate.profile(geo.phi).point)
+        second = {"profile": _xy(outline), "followers": _followers(analysis, reach, plate)}
     return {
         "groove": groove,
         "second": second,
@@ -104,7 +103,7 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
         "rotation": cam.rotation.value,
         "caption": f"To scale, cam frame at φ = 0, turning {cam.rotation.value}: the profile (filled), the "
         f"{trace_name(analysis)} (dashed), the base circle r = {cam.base_radius:g} mm (dotted) and "
-        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°." + _positive_caption(analysis),
+        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°." + family_caption(analysis),
         "profile_radius_max": float(np.hypot(*profile.T).max()),
     }
 
@@ -147,10 +146,44 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
         _chart("torque", "Input torque", "N·mm", one("T", dyn.torque), []),
         _chart("stress", "Hertz stress", "MPa", one("σ", dyn.hertz_stress), stress_limits),
     ]
+    _second_plate_curves(analysis, charts, index)
     points = _table_points(analysis)
     if points is not None:
         charts[0]["points"] = points
     return _series(np.degrees(phi), index), charts
+
+
+def _second_plate_curves(analysis: Analysis, charts: list[dict[str, Any]], index: np.ndarray) -> None:
+    """Add every further part's own force and stress to ``charts`` (a conjugate pair's second plate).
+
+    Each part's curves come from its own dynamics (its roller, its drive sign),
+    by the same code as the first part's. Where a part carries a pocket (a
+    groove), the outer flank drives where the signed contact force is
+    negative; its force is drawn as its own series (magnitude, N) beside the
+    inner flank's.
+    """
+    by_key = {c["key"]: c for c in charts}
+    parts = analysis.parts
+    n = len(np.asarray(analysis.geometry.phi))
+    later = [
+        (i, r.dynamics)
+        for i, r in enumerate(parts[1:], start=2)
+        if len(np.asarray(r.dynamics.contact_force)) == n
+    ]
+    if later:
+        by_key["force"]["series"][0]["label"] = "F plate 1"
+        by_key["stress"]["series"][0]["label"] = "σ plate 1"
+    for i, dyn in later:
+        by_key["force"]["series"].append({"label": f"F plate {i}", "y": _series(dyn.contact_force, index)})
+        by_key["stress"]["series"].append({"label": f"σ plate {i}", "y": _series(dyn.hertz_stress, index)})
+    if parts[0].part.pocket is not None:
+        force = np.asarray(analysis.dynamics.contact_force, dtype=float)
+        inner = np.where(force >= 0.0, force, np.nan)  # gaps where the other flank drives
+        outer = np.where(force < 0.0, -force, np.nan)
+        by_key["force"]["series"] += [
+            {"label": "F inner flank drives", "y": _series(inner, index)},
+            {"label": "F outer flank drives (|F|)", "y": _series(outer, index)},
+        ]
 
 
 def _table_points(analysis: Analysis) -> dict[str, list[float]] | None:

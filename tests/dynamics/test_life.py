@@ -177,7 +177,7 @@ def test_track_life_at_the_worst_point():
     assert life.cycles == pytest.approx(n, rel=1e-9)
     assert life.hours == pytest.approx(n / (100.0 / 60.0) / 3600.0, rel=1e-9)
     (finding,) = life_findings(spec, roller=None, track=life)
-    assert finding.field == "life.track_material" and finding.limit == 1e9
+    assert finding.field == "life.track_slope" and finding.limit == 1e9
     entry = summary_entry(None, life, sliding_max=None)
     assert entry["track_life_h"] == life.hours
 

@@ -226,7 +226,7 @@ def test_table1_stroke_maximum_against_exact_dudley_polynomial():
     )
     assert sampled_max == pytest.approx(-best.fun, rel=1e-5)
     assert sampled_at == pytest.approx(best.x, abs=math.radians(0.1))
-    # Reported in the README: about 14.7 N·m near 35.6° of cam rotation.
+    # Reported in docs/verification.md: about 14.7 N·m near 35.6° of cam rotation.
     assert 14_000.0 < sampled_max < 15_500.0
 
 

@@ -35,7 +35,7 @@ _SUB = np.linspace(0.0, 1.0, 9)  # points along each chord
 def exact(name: str, plate: int, offset: float) -> np.ndarray:
     """(n, 2) dense exact curve of one sample's plate at one offset from its profile."""
     result = built(name)
-    cam = result.analysis.cam if plate == 1 else result.analysis.positive.partner
+    cam = result.analysis.parts[plate - 1].part.cam
     phi = np.linspace(0.0, 2.0 * math.pi, _DENSE, endpoint=False)
     return np.asarray(cam.offset(phi, offset).point)
 
@@ -68,7 +68,7 @@ def along(loop: np.ndarray) -> np.ndarray:
 def curves(name: str) -> dict[str, tuple[int, float]]:
     """Layer → (plate, offset from the profile) of every curve a sample's profile_poly.dxf draws."""
     analysis = built(name).analysis
-    groove = analysis.positive.groove
+    (groove,) = analysis.parts[0].part.checks or (None,)  # a groove cam's flank checks
     if groove is not None:
         return {"GROOVE_INNER": (1, groove.inner_offset), "GROOVE_OUTER": (1, groove.outer_offset)}
     return {"CAM_PROFILE": (1, 0.0)}
@@ -79,7 +79,7 @@ def test_polylines_and_stl_keep_within_chord_tolerance_of_the_exact_profile(name
     result = _build(name, folder)
     out = folder / name
     design = result.analysis.design
-    plates = [("", 1)] + ([("_2", 2)] if result.analysis.positive.partner is not None else [])
+    plates = [("", 1)] + ([("_2", 2)] if len(result.analysis.parts) > 1 else [])
     for suffix, plate in plates:
         doc = ezdxf.readfile(out / f"profile_poly{suffix}.dxf")
         layers = curves(name)
@@ -110,7 +110,7 @@ def test_polylines_and_stl_keep_within_chord_tolerance_of_the_exact_profile(name
         zmin, zmax = mesh.bounds[:, 2]
         z = (
             zmax - 0.5 * design.groove.depth
-            if result.analysis.positive.groove is not None
+            if result.analysis.parts[0].part.pocket is not None
             else 0.5 * (zmin + zmax)
         )
         section = mesh.section(plane_origin=(0.0, 0.0, z), plane_normal=(0.0, 0.0, 1.0))

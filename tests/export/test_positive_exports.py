@@ -79,8 +79,8 @@ def test_groove_solid_is_the_blank_less_bore_and_groove(groove: BuildResult) -> 
     length = float(np.sum(np.hypot(*np.diff(outer.point, axis=0).T)))
     assert cut == pytest.approx(blank - groove_area - bore.area, abs=slack + 2 * tol * length)
     # the groove's walls lie on the exact flanks (chord tolerance + the certified fit errors)
-    fits = groove.analysis.positive.flank_fits
-    assert fits is not None
+    fits = groove.analysis.parts[0].flank_fits
+    assert len(fits) == 2
     by_size = sorted(rings, key=lambda r: abs(_area(r)))
     for ring, flank, fit in ((by_size[1], inner, fits[0]), (by_size[2], outer, fits[1])):
         assert distance_to_polygon(ring, flank.point).max() < tol + fit.max_error + 1e-6
@@ -96,8 +96,8 @@ def test_groove_width_in_the_solid_is_twice_the_roller_plus_clearance(groove: Bu
     # every point of the outer wall is 2 r_f + c from the inner wall (the groove's constant width)
     width = distance_to_polygon(outer_wall[::50], inner_wall)
     expected = 2.0 * design.follower.roller_radius + design.groove.clearance
-    fits = groove.analysis.positive.flank_fits
-    assert fits is not None
+    fits = groove.analysis.parts[0].flank_fits
+    assert len(fits) == 2
     # each wall is a chord polygon of its fitted flank: within the chord tolerance and the fit error
     slack = 2.0 * design.mesh.chord_tolerance + fits[0].max_error + fits[1].max_error
     assert np.abs(width - expected).max() < slack
@@ -107,10 +107,10 @@ def test_conjugate_pair_writes_two_plates_on_their_own_profiles(pair: BuildResul
     names = {p.name for p in pair.files}
     assert {"cam.stl", "cam_2.stl", "profile.dxf", "profile_2.dxf", "profile_poly_2.dxf"} <= names
     analysis = pair.analysis
-    partner = analysis.positive.partner
+    partner = analysis.parts[1].part.cam
     assert isinstance(partner, Cam)
     plates = {"": analysis.cam.profile(DENSE).point, "_2": partner.profile(DENSE).point}
-    fits = {"": analysis.fit, "_2": analysis.positive.partner_fit}
+    fits = {"": analysis.fit, "_2": analysis.parts[1].fit}
     for suffix, exact in plates.items():
         other = plates["_2" if suffix == "" else ""]
         mesh = trimesh.load(pair.outdir / f"cam{suffix}.stl")
@@ -161,8 +161,8 @@ def _distance_to_arcs(points: np.ndarray, arcs: list) -> np.ndarray:
 
 def test_groove_dxf_files_hold_both_flanks_on_their_exact_curves(groove: BuildResult) -> None:
     design, cam = groove.analysis.design, groove.analysis.cam
-    fits = groove.analysis.positive.flank_fits
-    assert fits is not None
+    fits = groove.analysis.parts[0].flank_fits
+    assert len(fits) == 2
     inner, outer = groove_flanks(cam, DENSE, design.groove.clearance)
     exact = {"GROOVE_INNER": (inner.point, fits[0]), "GROOVE_OUTER": (outer.point, fits[1])}
     folder = groove.outdir

@@ -374,8 +374,8 @@ def test_groove_cam_step_is_the_blank_less_bore_and_groove(tmp_path: Path) -> No
     shape = read_step(tmp_path / "out" / "cam.step")
     assert len(shapes_of(shape, TopAbs_SOLID)) == 1
     assert BRepCheck_Analyzer(shape).IsValid()
-    flanks = result.analysis.positive.flank_fits
-    assert flanks is not None
+    flanks = result.analysis.parts[0].flank_fits
+    assert len(flanks) == 2
     bore = design.plate().bore
     assert bore is not None
     t, depth, radius = design.cam.thickness, design.groove.depth, design.cam.outer_radius
@@ -400,7 +400,7 @@ def test_conjugate_pair_writes_a_step_file_per_plate(tmp_path: Path) -> None:
 
     design = load_design(ROOT / "samples" / "indexing_conjugate.toml")
     result = build(design, tmp_path / "out", only=["step"])
-    fits = {"cam.step": result.analysis.fit, "cam_2.step": result.analysis.positive.partner_fit}
+    fits = {"cam.step": result.analysis.fit, "cam_2.step": result.analysis.parts[1].fit}
     bore = design.plate().bore
     assert bore is not None
     for name, fit in fits.items():

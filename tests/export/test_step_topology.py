@@ -103,7 +103,7 @@ def groove(tmp_path_factory):
     design = load_design(ROOT / "samples" / "groove_rocker.toml")
     out = tmp_path_factory.mktemp("groove") / "out"
     result = build(design, out, only=["step"])
-    return design, result.analysis.positive.flank_fits, out / "cam.step"
+    return design, result.analysis.parts[0].flank_fits, out / "cam.step"
 
 
 def test_groove_blank_faces_volume_and_shell(groove):

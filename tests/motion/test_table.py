@@ -54,7 +54,7 @@ def table_program(phi, lift, **kw) -> MotionProgram:
 
 @pytest.mark.parametrize("seed", range(5))
 def test_noisy_table_recovers_the_law_within_the_noise(seed):
-    """README's bounds: s within 2σ, v within 1.5 % of peak |v|, a within 25 % of peak |a| (1° table)."""
+    """The docs' bounds: s within 2σ, v within 1.5 % of peak |v|, a within 25 % of peak |a| (1° table)."""
     phi, lift = noisy_table(seed)
     prog = table_program(phi, lift)
     dense = np.linspace(0.0, 2 * math.pi, 20_001)

@@ -286,8 +286,8 @@ def test_every_sample_opens_and_draws_its_family(browser, tmp_path, sample):
         assert [e["message"] for e in browser.get_log("browser") if e["level"] == "SEVERE"] == []
         result = analyse(load_design(design), fit=False, toolpath=False, strict=False)
         assert shown["error"] == ""
-        assert shown["groove"] == (result.positive.groove is not None)
-        assert shown["second"] == (result.positive.partner is not None and result.positive.second_plate)
+        assert shown["groove"] == (result.parts[0].part.pocket is not None)
+        assert shown["second"] == any(r.part.made for r in result.parts[1:])
         assert shown["radius"] == pytest.approx(np.hypot(*np.asarray(result.geometry.profile.point).T).max())
         if shown["ok_banner"]:  # "No warnings": no limit broken, and no card may be red
             assert not result.findings and shown["over"] == []
@@ -410,7 +410,7 @@ def test_family_switch_draws_the_second_plate(browser, tmp_path):
         assert browser.execute_script("return !!document.getElementById('second-plate')")
         _motion_saved(browser, design)
         result = analyse(load_design(design), fit=False, toolpath=False, strict=False)
-        assert result.positive.partner is not None and result.positive.second_plate
+        assert len(result.parts) == 2 and result.parts[1].part.made
 
 
 def test_invalid_input_marks_everything_out_of_date_and_keeps_the_last_result(browser, served):

@@ -155,7 +155,7 @@ PT_PER_MM = 72.0 / 25.4
 
 
 def test_dxf2pdf_at_true_scale_centred(built: Built, tmp_path):
-    """``librecad dxf2pdf -c -s 1`` (the README's 1:1 command): the profile prints at its true size in mm.
+    """``librecad dxf2pdf -c -s 1`` (docs/reference/outputs.md): the profile prints at its true size in mm.
 
     Without ``-a`` or ``-c`` LibreCAD 2.2 collapses the drawing to a point (an empty page);
     centred at scale 1 the black strokes span the exact profile's width and height.

@@ -28,8 +28,7 @@ pytestmark = [
 def test_rs274_runs_the_second_plate_and_it_is_proved_on_that_plate(tmp_path):
     design = load_design(ROOT / "samples" / "indexing_conjugate.toml")
     result = build(design, tmp_path / "out", only=["gcode"])
-    partner = result.analysis.positive.partner
-    assert partner is not None
+    partner = result.analysis.parts[1].part.cam
     text = (tmp_path / "out" / "cam_2.ngc").read_text(encoding="ascii")
     proc, canon = run_rs274(text, design.gcode.tool_number, tmp_path)
     assert proc.returncode == 0, errors(proc)

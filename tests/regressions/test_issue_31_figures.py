@@ -118,13 +118,12 @@ def test_groove_check_names_the_flank(tmp_path: Path, capsys: pytest.CaptureFixt
 def test_conjugate_second_plate_stress_uses_its_own_roller(r2: float) -> None:
     design, _ = _sample("indexing_conjugate.toml", conjugate={"roller_radius": r2})
     result = analyse(design, fit=False, toolpath=False)
-    drive = result.positive
-    assert drive.partner is not None and drive.partner_dynamics is not None
-    dyn = drive.partner_dynamics
+    second = result.parts[1]  # the pair's second plate, with its own roller
+    dyn = second.dynamics
     e_star = _contact_modulus(206000.0, 0.3, 206000.0, 0.3)
     ext = dyn.hertz_stress_max
     assert ext is not None
-    st = drive.partner.state(np.array([ext.phi]))
+    st = second.part.cam.state(np.array([ext.phi]))
     force = float(np.interp(ext.phi, dyn.phi, dyn.contact_force))
     inv = 1.0 / r2 + 1.0 / float(st.profile.rho[0])  # the second roller on the second plate
     assert ext.value == pytest.approx(_line_contact(force, inv, 12.0, e_star), rel=1e-4)

@@ -39,6 +39,7 @@ __all__ = [
     "make_grid",
     "periodic_states",
     "propagate",
+    "propagate_each",
     "train_system",
 ]
 
@@ -245,14 +246,36 @@ def propagate(
 
     ``state`` (N + 1, n) from :func:`periodic_states`; returns (m, n).
     """
+    phi = np.asarray(phi, dtype=float)
+    which = np.zeros(phi.size, dtype=int)
+    return propagate_each(program_grid, system, np.array([omega]), state[None], which, phi)
+
+
+def propagate_each(
+    program_grid: Grid,
+    system: System,
+    omega: FloatArray,
+    states: FloatArray,
+    which: np.ndarray,
+    phi: FloatArray,
+) -> FloatArray:
+    """Carry the periodic grid states of many speeds exactly to angles ``phi`` (m,) [rad] in [0, 2π].
+
+    Point k belongs to speed ``which[k]``: ``omega`` (S,) [rad/s], ``states``
+    (S, N + 1, n) from :func:`periodic_states`; returns (m, n). The state
+    moves from the grid angle at or before φ over the partial step with the
+    exact transition of the train and the sub-interval's Hermite lift, all
+    points in one batch of matrix exponentials.
+    """
     g = program_grid
     phi = np.asarray(phi, dtype=float)
+    which = np.asarray(which, dtype=int)
     i = np.clip(np.searchsorted(g.phi, phi, side="right") - 1, 0, g.piece.size - 1)
     h = g.step[g.piece[i]]
     theta = np.clip((phi - g.phi[i]) / h, 0.0, 1.0)
-    tau = np.maximum(theta * h / omega, 1e-300)
+    tau = np.maximum(theta * h / np.asarray(omega, dtype=float)[which], 1e-300)
     phi_t, gain = _augmented(system, tau)
     coeff = g.coeff[i] * theta[:, None] ** np.arange(_ORDER)  # the sub-interval's polynomial in its own u
     coeff = np.concatenate((coeff, np.ones((phi.size, 1))), axis=1)
-    out = np.einsum("ikl,il->ik", phi_t, state[i]) + np.einsum("ikl,il->ik", gain, coeff)
+    out = np.einsum("ikl,il->ik", phi_t, states[which, i]) + np.einsum("ikl,il->ik", gain, coeff)
     return np.asarray(out, dtype=float)

@@ -17,9 +17,16 @@ import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
-from camcad.dynamics.vibration._exact import Grid, make_grid, periodic_states, propagate, train_system
+from camcad.dynamics.vibration._exact import (
+    Grid,
+    make_grid,
+    periodic_states,
+    propagate,
+    propagate_each,
+    train_system,
+)
 from camcad.dynamics.vibration.separation import Flight, periodic_with_flight
-from camcad.extremes import Extreme, Side, extremes_rows
+from camcad.extremes import Extreme, Side, extremes_each, extremes_rows
 from camcad.motion.segments import SegmentKind
 
 if TYPE_CHECKING:
@@ -168,6 +175,47 @@ def _force(train: Train, s: FloatArray, v: FloatArray, omega: float, z: FloatArr
     return train.contact_rate * (s * u - z[:, 0]) + train.contact_damping * (v * omega * u - z[:, train.dof])
 
 
+def _refined(
+    program: Lift,
+    aim: Lift,
+    train: Train,
+    grid: Grid,
+    system: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    omega: FloatArray,
+    states: FloatArray,
+    joints: list[float],
+    error: FloatArray,
+    force: FloatArray,
+) -> tuple[FloatArray, FloatArray]:
+    """True max |x − y| and min contact force (S,) of speeds ``omega`` (S,) from their grid values (S, N).
+
+    Rows 2k and 2k + 1 of :func:`extremes_each` are speed k's |x − y| and
+    force; a speed without a periodic state (NaN) gives NaN.
+    """
+    count = omega.size
+    u = train.unit
+
+    def pick(p: FloatArray, rows: np.ndarray, side: Side) -> FloatArray:
+        k = rows // 2
+        m = program.evaluate(p, side=side)
+        ys = np.asarray(aim.evaluate(p, side=side).s)
+        z = propagate_each(grid, system, omega, states, k, np.mod(p, TWO_PI) if side == "right" else p)
+        err = np.abs(z[:, train.dof - 1] / u - ys)
+        f = train.contact_rate * (np.asarray(m.s) * u - z[:, 0]) + train.contact_damping * (
+            np.asarray(m.v) * omega[k] * u - z[:, train.dof]
+        )
+        return np.where(rows % 2 == 0, err, f)
+
+    values = np.empty((2 * count, error.shape[1]))
+    values[0::2] = np.abs(error)
+    values[1::2] = force
+    found = extremes_each(pick, 2 * count, grid.phi[:-1], joints, ("max", "min") * count, values=values)
+    ok = np.all(np.isfinite(states), axis=(1, 2))
+    peak = np.array([found[2 * k].value for k in range(count)])
+    low = np.array([found[2 * k + 1].value for k in range(count)])
+    return np.where(ok, peak, np.nan), np.where(ok, low, np.nan)
+
+
 def train_response(
     program: Lift,
     train: Train,
@@ -284,9 +332,11 @@ class SpeedMap:
     residuals
         (S, D) residual vibration amplitude at the start of each dwell [lift unit].
     error_peak
-        (S,) largest |x − s| on the grid [lift unit].
+        (S,) true largest |x − y| over the turn [lift unit] (refined between
+        grid angles on the exact solution, one-sided limits at joints).
     contact_force_min
-        (S,) smallest contact force on the grid [N or N·mm].
+        (S,) true smallest contact-held force over the turn [N or N·mm],
+        one-sided limits at joints included.
     leaves
         (S,) whether a spring-loaded follower would leave the cam there.
     dwells
@@ -323,29 +373,38 @@ def speed_map(
     -------
     SpeedMap
         Residuals are exact (from the state at each dwell's start); the peak
-        error and minimum force are those of the grid samples. At speeds
+        error and minimum force are true extremes, as in
+        :func:`train_response`: every speed's samples and both sides of every
+        joint, then each promising sampled peak refined on the exact solution
+        between grid angles (:func:`camcad.extremes.extremes_each`, all speeds
+        of a chunk in one batch of partial-step propagations). At speeds
         where the follower leaves the cam the figures are the contact-held
         ones, flagged by ``leaves``.
     """
     speeds = np.asarray(speeds_rpm, dtype=float).ravel()
     omega = speeds / _RPM
     grid = make_grid(program, step)
-    y = np.asarray((program if target is None else target).evaluate(grid.phi[:-1]).s)
+    aim = program if target is None else target
+    y = np.asarray(aim.evaluate(grid.phi[:-1]).s)
     u = train.unit
+    system = train_system(train)
+    joints = [bp.phi for bp in program.breakpoints]
     res = np.zeros((speeds.size, len(dwells(program))))
     peak = np.zeros(speeds.size)
     fmin = np.zeros(speeds.size)
     chunk = 50  # bounds the memory of the state history
     for lo in range(0, speeds.size, chunk):
         sl = slice(lo, lo + chunk)
-        states = periodic_states(grid, train_system(train), omega[sl])
+        states = periodic_states(grid, system, omega[sl])
         res[sl] = _residuals(train, grid, states, program)
         x = states[:, :-1, train.dof - 1] / u
-        peak[sl] = np.max(np.abs(x - y), axis=1)
         force = train.contact_rate * (grid.s * u - states[:, :-1, 0]) + train.contact_damping * (
             grid.v[None, :] * omega[sl, None] * u - states[:, :-1, train.dof]
         )
-        fmin[sl] = np.min(force, axis=1)
+        peak[sl], fmin[sl] = _refined(
+            program, aim, train, grid, system, omega[sl], states, joints, x - y, force
+        )
+    leaves = (fmin < 0.0) & spring_loaded
     leaves = (fmin < 0.0) & spring_loaded
     readonly(speeds, res, peak, fmin)
     leaves.flags.writeable = False

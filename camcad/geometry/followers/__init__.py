@@ -13,7 +13,7 @@ The module also declares what its ``follower.type`` means, as a
 rules), required keys, lift unit, cross-field check, and how it is built.
 :data:`FOLLOWER_TYPES` is the registry: every module of this package that
 declares a ``TYPE`` is found here, so a new kind of follower is one new
-module. See the README's "Adding a follower".
+module. See "Adding a follower" in docs/reference/architecture.md.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Translating flat-faced follower (the worked example of README "Adding a follower")."""
+"""Translating flat-faced follower (the worked example of docs/reference/architecture.md)."""
 
 from __future__ import annotations
 

@@ -166,7 +166,7 @@ def test_an_independent_integrator_driven_by_the_built_cam_follows_the_program(p
     train = Train(
         mass=(m,),
         contact_rate=kf,
-        contact_damping=2.0 * zeta * math.sqrt(kf * m),  # c = 2ζ√(k_f m), the README's definition
+        contact_damping=2.0 * zeta * math.sqrt(kf * m),  # c = 2ζ√(k_f m) (docs/guides/vibration.md)
         spring_rate=design.dynamics.spring_rate,
         preload=design.dynamics.spring_preload,
         weight=(design.dynamics.follower_mass * G,),

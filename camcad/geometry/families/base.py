@@ -1,0 +1,236 @@
+"""What a cam family is: the parts it makes, and what each part needs from the later stages.
+
+A cam family (plate, groove, conjugate pair; a barrel later) turns the one
+designed :class:`~camcad.geometry.cam.Cam` into the :class:`Part` s to make.
+Every later stage maps over the parts with the same code: the geometry and
+the rigid dynamics of each part's own cam (its own roller sets its Hertz
+contact, its ``drive_sign`` says which way it pushes), the certified fit of
+its outline and of its further curves (:class:`Flank`), its tool path and its
+files (``cam{suffix}.*``). What only one family knows (a groove's flank
+checks, a pair's ``second_plate`` summary section, the drawing's caption)
+stays in that family's module.
+
+The shape of a part is data the writers read, not a family name: a part
+with no :attr:`Part.pocket` is a plate cut along its outline; one with a
+:class:`Pocket` is a blank with a pocket between two flanks. A barrel cam
+adds its own shape (walls on a cylinder) here and its writers below.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Protocol, TypedDict
+
+from camcad.findings import Finding
+from camcad.geometry.cam import Cam
+from camcad.geometry.spec import ConjugateSpec, GrooveSpec
+
+__all__ = ["CamFamily", "Drive", "FamilyOptions", "Flank", "Part", "PartCheck", "PartResults", "Pocket"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FamilyOptions:
+    """What the families read from the design: the ``[groove]`` and ``[conjugate]`` tables, the blank.
+
+    ``outer_radius`` [mm]: a groove cam's blank (None: no blank);
+    ``hole_radius`` [mm]: the bore's farthest reach, keyway included (0 without a bore).
+    """
+
+    groove: GrooveSpec = field(default_factory=GrooveSpec)
+    conjugate: ConjugateSpec = field(default_factory=ConjugateSpec)
+    outer_radius: float | None = None
+    hole_radius: float = 0.0
+
+
+class Drive(TypedDict):
+    """How a family holds the follower on (the fields of :class:`camcad.dynamics.spec.DynamicsSetup`).
+
+    ``positive_drive``: no spring holds it, the cam drives it both ways;
+    ``clearance`` [mm]: a groove's radial play; ``flank_offsets`` [mm]: a
+    groove's flanks as offsets of the profile, None for any other family.
+    """
+
+    positive_drive: bool
+    clearance: float
+    flank_offsets: tuple[float, float] | None
+
+
+class PartCheck(Protocol):
+    """A family's own check of a part (a groove's flanks): its findings and its summary figures."""
+
+    @property
+    def findings(self) -> tuple[Finding, ...]:
+        """The check's broken limits."""
+        ...
+
+    def summary(self) -> dict[str, Any]:
+        """The check's figures for ``summary.json``."""
+        ...
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Flank:
+    """A further curve of a part, fitted and drawn beside its outline: an offset of its cam's profile.
+
+    ``name`` keys its fit in ``summary.json``; ``layer`` is its DXF layer;
+    ``offset`` [mm] the distance from the profile (``Cam.offset(φ, offset)``).
+    """
+
+    name: str
+    layer: str
+    offset: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Pocket:
+    """A blank of ``outer_radius`` [mm] with a pocket ``depth`` [mm] deep between ``flanks`` (inner, outer).
+
+    ``clearance`` [mm]: the radial play of the roller in the pocket;
+    ``width`` [mm]: the pocket's width, flank to flank.
+    """
+
+    outer_radius: float
+    depth: float
+    clearance: float
+    width: float
+    flanks: tuple[Flank, Flank]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Part:
+    """One part a cam family makes, and what every later stage needs of it.
+
+    Attributes
+    ----------
+    cam
+        The part's exact cam (its follower, its roller): geometry, dynamics,
+        fit and tool path all run on it.
+    suffix
+        Its files' name suffix: ``cam{suffix}.stl``, ``profile{suffix}.dxf``.
+    label
+        Empty for the family's first part; else its name ("second plate"),
+        which prefixes its findings and names its G-code program.
+    drive_sign
+        +1 where the part's roller pushes the follower forwards, −1 where it
+        pushes it back (a conjugate pair's second plate): the sign that turns
+        the generalised force into the part's contact force.
+    made
+        False for a part analysed but not made on its own (the second roller
+        of a constant-breadth pair runs on the first plate).
+    pocket
+        None: a plate, cut along its outline. Else the blank and the pocket
+        between two flanks (a groove cam).
+    checks
+        The family's own checks of the part (a groove's flank checks).
+    """
+
+    cam: Cam
+    suffix: str = ""
+    label: str = ""
+    drive_sign: float = 1.0
+    made: bool = True
+    pocket: Pocket | None = None
+    checks: tuple[PartCheck, ...] = ()
+
+    @property
+    def flanks(self) -> tuple[Flank, ...]:
+        """The further curves fitted and drawn beside the outline (a pocket's flanks), else none."""
+        return () if self.pocket is None else self.pocket.flanks
+
+    @property
+    def findings(self) -> tuple[Finding, ...]:
+        """The findings of the family's own checks of this part."""
+        return tuple(f for check in self.checks for f in check.findings)
+
+    def title(self, name: str) -> str:
+        """The part's name for a program or a drawing: ``name``, with its label in brackets."""
+        return f"{name} ({self.label})" if self.label else name
+
+
+class PartResults(Protocol):
+    """What the later stages computed for one part (:class:`camcad.analysis.PartResult` is one)."""
+
+    @property
+    def part(self) -> Part:
+        """The part."""
+        ...
+
+    @property
+    def geometry(self) -> Any:
+        """Its :class:`~camcad.geometry.GeometryAnalysis`."""
+        ...
+
+    @property
+    def dynamics(self) -> Any:
+        """Its :class:`~camcad.dynamics.DynamicsResult` (``phi``, ``contact_force``, ``summary()``)."""
+        ...
+
+    @property
+    def fit(self) -> Any:
+        """Its outline's :class:`~camcad.fit.ProfileFit`, or None."""
+        ...
+
+    @property
+    def flank_fits(self) -> tuple[Any, ...]:
+        """A :class:`~camcad.fit.ProfileFit` per flank (``part.flanks``), or none."""
+        ...
+
+
+class CamFamily(Protocol):
+    """A cam family: the parts it makes of a cam, its own ``summary.json`` section and caption."""
+
+    @property
+    def name(self) -> str:
+        """The TOML ``cam.style`` of the family."""
+        ...
+
+    @property
+    def table(self) -> str | None:
+        """The TOML table only this family reads (``[groove]``, ``[conjugate]``), or None."""
+        ...
+
+    @property
+    def needs_roller(self) -> bool:
+        """Whether the family drives its follower through a roller (positive drive does)."""
+        ...
+
+    @property
+    def one_plate(self) -> bool:
+        """Whether the family makes one plate cut along its outline (the FE check, the rotary machine)."""
+        ...
+
+    def check(
+        self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
+    ) -> None:
+        """Raise :class:`~camcad.errors.DesignError` (naming its field) where the design cannot be made.
+
+        ``base_radius``, ``roller_radius`` (the designed follower's) and ``thickness`` in mm.
+        """
+        ...
+
+    def check_cam(self, cam: Callable[[], Cam], options: FamilyOptions) -> None:
+        """Raise :class:`~camcad.errors.DesignError` where the designed cam cannot make the family's parts.
+
+        ``cam`` builds the designed cam (called only by a family that needs it).
+        """
+        ...
+
+    def parts(self, cam: Cam, options: FamilyOptions) -> tuple[Part, ...]:
+        """The parts to make of ``cam``, the designed one first."""
+        ...
+
+    def drive(self, roller_radius: float, options: FamilyOptions) -> Drive:
+        """How the family holds the follower on: :class:`Drive`, fields of the dynamics setup.
+
+        ``roller_radius`` [mm]: the designed follower's (0 for a flat face).
+        """
+        ...
+
+    def summary(self, results: Sequence[PartResults]) -> dict[str, Any]:
+        """The family's own sections of ``summary.json`` (none for a plate)."""
+        ...
+
+    def caption(self, parts: Sequence[Part]) -> str:
+        """What the cam drawing adds for this family, as a sentence (or nothing)."""
+        ...
