@@ -88,3 +88,18 @@ def serving(folder: Path, **options: Any) -> Iterator[tuple[Any, str, Path]]:
     finally:
         srv.shutdown()
         srv.server_close()
+
+
+@pytest.fixture(autouse=True)
+def _sigpipe_ignored() -> Iterator[None]:
+    """Python's own SIGPIPE setting (ignored) around every test.
+
+    A library a test loads in-process may set SIGPIPE back to its default; a
+    server thread writing to a socket the browser closed then kills the whole
+    test run with exit 141 (seen in the full suite after the Chromium tests).
+    """
+    import signal
+
+    signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+    yield
+    signal.signal(signal.SIGPIPE, signal.SIG_IGN)

@@ -183,7 +183,8 @@ def test_save_refused_when_the_file_changed_on_disk_shows_why(browser, served):
     browser.find_element("id", "save").click()
     _wait_for(browser, "document.getElementById('status').textContent.startsWith('not saved')", "the refusal")
     assert browser.find_element("id", "status").text == "not saved: the file changed on disk"
-    assert "changed on disk since it was loaded" in browser.find_element("id", "general-error").text
+    # the explanation stays on the page after the next analysis (which clears the field errors)
+    assert "changed on disk since it was loaded" in browser.find_element("id", "notice").text
     assert path.read_text(encoding="utf-8") == edited
     # reloading the page loads the file as it is now; Save then writes it, the comment kept
     browser.get(url)

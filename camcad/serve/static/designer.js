@@ -591,6 +591,8 @@ document.getElementById("save").addEventListener("click", async () => {
   let out;
   try { out = await answer(await post("/api/save", {values: values(), loaded: document.body.dataset.loaded})); } catch (err) { out = unreachable(); }
   if (out.errors) showErrors(out.errors);
+  // a refused save stays said where a later analysis does not clear it (it clears the field errors)
+  if (out.conflict && out.errors) document.getElementById("notice").textContent = out.errors[0].message;
   if (out.revision) document.body.dataset.loaded = out.revision;  // the file as saved is the one now loaded
   if (out.saved) segments.forEach((s, i) => { s.source = i; });  // the file's tables are now these
   notes++;
