@@ -81,10 +81,10 @@ def fit_error_along_profile(cam: Cam, fit: ProfileFit) -> tuple[FloatArray, Floa
         interior knot of the periodic curve [rad] (interpolated between samples).
     """
     step = min(cam.sample_step, FIT_STEP)
-    phi = cam.sample_phi(step)
+    phi = cam.curve_phi(step)
     while len(phi) < len(fit.params) and step > 1e-6:  # the fit halved its step to meet the tolerance
         step *= 0.5
-        phi = cam.sample_phi(step)
+        phi = cam.curve_phi(step)
     if len(phi) != len(fit.params):
         raise ValueError(f"fit has {len(fit.params)} samples, the cam's grids give {len(phi)}")
     exact = cam.profile(phi)

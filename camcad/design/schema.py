@@ -47,7 +47,7 @@ from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec, PlaneModel
 from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import Cam
-from camcad.geometry.families import FAMILIES, FamilyOptions, family_of
+from camcad.geometry.families import FAMILIES, family_of
 from camcad.geometry.followers import (
     DEFAULT_FOLLOWER,
     FOLLOWER_TYPES,
@@ -57,7 +57,7 @@ from camcad.geometry.followers import (
 )
 from camcad.geometry.followers.base import KeyRange
 from camcad.geometry.sensitivity import Tol
-from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
+from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, LinearSpec, Rotation
 from camcad.motion._blendlaws import MAX_POLYNOMIAL_DEGREE
 from camcad.motion.blend import resolve_blends
 from camcad.motion.laws import DUDLEY_MAX_DEGREE, LAWS, make_law
@@ -392,6 +392,11 @@ _SECTIONS: dict[str, dict[str, _Rule]] = {
         "depth": _Rule("float", check=_length),
         "clearance": _Rule("float", check=_between(0.0, 10.0, " mm")),
     },
+    "linear": {  # a linear cam's bar (camcad.geometry.families.linear)
+        "stroke_length": _Rule("float", check=_length),
+        "bar_height": _Rule("float", check=_length),
+        "speed_mm_s": _Rule("float", check=_between(0.0, MAX_FEED_MM_MIN, " mm/s", lo_open=True)),
+    },
     "conjugate": {
         "angle": _Rule("float", check=_between(1.0, 359.0, " degrees"), scale=DEG),
         "roller_radius": _Rule("float", check=_length),
@@ -552,6 +557,7 @@ _SPEC_CLASSES: dict[str, Callable[..., Any]] = {
     "gcode": GcodeSpec,
     "groove": GrooveSpec,
     "conjugate": ConjugateSpec,
+    "linear": LinearSpec,
 }
 
 _MOTION_KEYS = ("kind", "angle", "lift", "law")
@@ -1089,7 +1095,7 @@ def _check_style(design: Design) -> None:
     family = family_of(cam.style)
     if family.needs_roller and not fol.kind.two_sided:
         raise DesignError("cam.style", f"a {family.name} cam needs a roller follower, not {fol.kind.word}")
-    options = FamilyOptions(groove=design.groove, conjugate=design.conjugate, outer_radius=cam.outer_radius)
+    options = design.family_options()
     family.check(
         options, base_radius=cam.base_radius, roller_radius=fol.roller_radius, thickness=cam.thickness
     )
@@ -1367,6 +1373,15 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
         table = family.table
         if table is not None and table in data and table != own:
             raise DesignError(table, f"the [{table}] table applies to cam.style = '{table}' only")
+    linear = specs["linear"]
+    if linear.speed_mm_s is not None and linear.stroke_length > 0.0:  # the bar's speed sets the cycle rate
+        if "speed_rpm" in data["cam"]:
+            raise DesignError(
+                "linear.speed_mm_s", "give the cycle rate once: cam.speed_rpm or this, not both"
+            )
+        specs["cam"] = dataclasses.replace(
+            specs["cam"], speed_rpm=60.0 * linear.speed_mm_s / linear.stroke_length
+        )
     follower = specs["follower"]
     _check_follower_keys(follower.kind, data.get("follower", {}), data.get("dynamics", {}))
     raw_motion = data.get("motion")

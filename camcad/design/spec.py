@@ -25,7 +25,7 @@ from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import follower_from_spec
 from camcad.geometry.families import FamilyOptions, family_of
 from camcad.geometry.plate import BoreOutline, Plate
-from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
+from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, LinearSpec, Rotation
 from camcad.motion.segments import SegmentSpec
 from camcad.toolpath.spec import Dialect, Direction, GcodeSpec
 
@@ -73,6 +73,7 @@ class Design:
     gcode: GcodeSpec = field(default_factory=GcodeSpec)
     groove: GrooveSpec = field(default_factory=GrooveSpec)
     conjugate: ConjugateSpec = field(default_factory=ConjugateSpec)
+    linear: LinearSpec = field(default_factory=LinearSpec)  # a linear cam's bar ([linear])
     fea: FeaSpec | None = None  # the [fea] table: None when absent (the FE check then runs only on request)
     life: LifeSpec | None = None  # [life], [lubrication], [drive] (issue 35): None when absent
     lubrication: LubricationSpec | None = None
@@ -95,6 +96,7 @@ class Design:
         return FamilyOptions(
             groove=self.groove,
             conjugate=self.conjugate,
+            linear=self.linear,
             outer_radius=self.cam.outer_radius,
             hole_radius=0.0 if bore is None else bore.reach,
         )

@@ -23,7 +23,6 @@ import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.dynamics.film import entraining_speed
-from camcad.geometry.envelope import to_cam
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -102,9 +101,8 @@ def contact_motion(
     if cam.kinematics.rolls:
         slip = np.zeros_like(p)
     else:
-        sigma = cam.sigma
-        contact = to_cam(p, np.asarray(prof.point, dtype=float), -sigma)  # machine frame
-        t_machine = to_cam(p, tangent, -sigma)
+        contact = cam.to_machine(p, np.asarray(prof.point, dtype=float))  # machine frame
+        t_machine = cam.to_machine(p, tangent)
         guide = cam.kinematics.guide
         direction = guide.driven(contact)
         m = cam.motion(p) if motion is None else motion
@@ -113,7 +111,7 @@ def contact_motion(
             lever = np.hypot(*(contact - np.asarray(guide.pivot, dtype=float)).T)
             rate = np.radians(rate) * lever  # ψ̇ r: the arm's point at the contact [mm/s]
         follower = rate[:, None] * direction
-        cam_velocity = sigma * omega * np.column_stack((-contact[:, 1], contact[:, 0]))  # σω ẑ × C
+        cam_velocity = omega * cam.surface_rate(contact)  # σω ẑ × C on a disc, (−cω, 0) on a bar
         slip = np.einsum("ij,ij->i", follower - cam_velocity, t_machine)
     u = entraining_speed(w, slip)
     sliding = np.abs(slip)

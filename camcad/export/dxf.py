@@ -647,6 +647,10 @@ def write_part_dxfs(
     A part with a pocket is drawn as its blank (``BLANK``) with the pocket's
     flanks (their fits ``flank_fits``, on the flanks' layers); a plate as its outline.
     """
+    if part.bar is not None:  # a linear cam's bar: its open edge and three sides (camcad.export.bar)
+        from camcad.export.bar import write_bar_dxfs
+
+        return write_bar_dxfs(folder, part, fit=fit, plate=plate, options=options)
     curves: tuple[DxfCurve, ...] | None = None
     blank_radius: float | None = None
     if part.pocket is not None:

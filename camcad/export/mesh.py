@@ -500,6 +500,10 @@ def write_part_meshes(
     fits ``flank_fits`` (:func:`build_groove_solid`); a plate is its outline
     ``fit`` extruded (:func:`build_solid`).
     """
+    if part.bar is not None:  # a linear cam's bar (camcad.export.bar)
+        from camcad.export.bar import write_bar_mesh
+
+        return write_bar_mesh(outdir, part, fit=fit, plate=plate, options=options, formats=formats)
     solid: SolidResult | GrooveSolidResult
     if part.pocket is not None:
         inner, outer = flank_fits

@@ -248,6 +248,10 @@ def write_part_step(
     named and placed as mounted, :func:`plate_body`), 0 for a family's only part.
     """
     path = Path(folder) / f"cam{part.suffix}.step"
+    if part.bar is not None:  # a linear cam's bar (camcad.export.bar)
+        from camcad.export.bar import write_bar_step
+
+        return write_bar_step(folder, part, fit=fit, plate=plate)
     if part.pocket is not None:
         inner, outer = flank_fits
         body = groove_body(

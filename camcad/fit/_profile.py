@@ -55,7 +55,15 @@ from camcad.fit.bspline import (
     lsq_clamped,
     lsq_periodic,
 )
-from camcad.fit.certify import Certificate, ExactProfile, certify, certify_exact, normal_distance, seam_jumps
+from camcad.fit.certify import (
+    Certificate,
+    ExactProfile,
+    certify,
+    certify_exact,
+    certify_exact_open,
+    normal_distance,
+    seam_jumps,
+)
 from camcad.fit.curve import BSplineCurve
 from camcad.fit.knots import (
     MIN_SAMPLE_GAP,
@@ -69,7 +77,7 @@ from camcad.fit.knots import (
 from camcad.fit.result import ProfileFit
 from camcad.fit.seam import longest_stretch, seam_parameter
 
-__all__ = ["Breakpoint", "ProfileFit", "fit_points", "fit_profile"]
+__all__ = ["Breakpoint", "ProfileFit", "fit_open_profile", "fit_points", "fit_profile"]
 
 
 @runtime_checkable
@@ -265,7 +273,8 @@ class _Search:
         at_samples, _ = certify(trial.curve, prob.points, trial.params)
         if prob.exact is None:
             return at_samples, None
-        return at_samples, certify_exact(trial.curve, prob.exact, prob.points, at_samples.foot)
+        bound = certify_exact if prob.periodic else certify_exact_open
+        return at_samples, bound(trial.curve, prob.exact, prob.points, at_samples.foot)
 
 
 def _certified_max(certs: tuple[Certificate, Certificate | None]) -> float:
@@ -563,6 +572,48 @@ def _fit_closed(
         automatic_budget=max_control_points is None,
         names=names,
         seam_window=None if stretch is None else (u_of(lo + quarter), u_of(hi - quarter)),
+    )
+    return _result(problem, *_search(problem))
+
+
+def fit_open_profile(
+    phi: FloatArray,
+    points: FloatArray,
+    *,
+    exact: Callable[[FloatArray], FloatArray],
+    breakpoints: Sequence[tuple[float, int] | Breakpoint],
+    tolerance: float,
+    max_control_points: int | None,
+    degree: int,
+    names: Names,
+) -> ProfileFit:
+    """A clamped open B-spline of an exact open curve (a linear cam's edge), certified over its whole length.
+
+    As :func:`fit_profile` without the wrap: ``phi`` (n,) increases strictly
+    from the curve's start to its end (both included), ``points`` (n, 2) [mm]
+    are the exact curve there, the breakpoints inside become knots of
+    multiplicity p − k, and the certificate bounds the distance from the
+    whole exact curve (:func:`camcad.fit.certify.certify_exact_open`).
+    """
+    _check_options(tolerance, max_control_points, degree)
+    pts = _check_points(points, degree)
+    ang = np.asarray(phi, dtype=float)
+    if ang.shape != (len(pts),) or np.any(np.diff(ang) <= 0.0):
+        raise ValueError("phi must increase strictly, one angle per point")
+    params = chord_length_params(pts, closed=False)
+    pairs = [(bp.phi, bp.continuity) if isinstance(bp, Breakpoint) else bp for bp in breakpoints]
+    inside = [(float(p), int(k)) for p, k in pairs if ang[0] < p < ang[-1]]
+    breaks = [(float(np.interp(p, ang, params)), k) for p, k in inside]
+    problem = _Problem(
+        params=params,
+        points=pts,
+        exact=ExactProfile(point=exact, phi=ang, breaks=np.array([p for p, _ in inside], dtype=float)),
+        fixed=fixed_knots(breaks, degree=degree, periodic=False),
+        degree=degree,
+        tolerance=tolerance,
+        max_control_points=AUTO_MAX_CONTROL_POINTS if max_control_points is None else max_control_points,
+        automatic_budget=max_control_points is None,
+        names=names,
     )
     return _result(problem, *_search(problem))
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from camcad.fit._limits import Names, SamplesTooFewError
-from camcad.fit._profile import _fit_closed
+from camcad.fit._profile import _fit_closed, fit_open_profile
 from camcad.fit.result import ProfileFit
 from camcad.geometry.cam import Cam
 
@@ -26,6 +26,9 @@ def fit_cam_profile(
     offset: float = 0.0,
 ) -> ProfileFit:
     """Certified B-spline of ``cam.profile`` (or of its offset ``cam.offset(φ, offset)``) over one turn.
+
+    A disc cam's closed profile gives a periodic B-spline; a linear cam's
+    open edge (``cam.closed`` false) a clamped one from φ = 0 to 2π.
 
     Samples the exact profile (breakpoints included), puts knots at the
     motion breakpoints, and certifies the result against ``cam.profile``
@@ -74,9 +77,10 @@ def fit_cam_profile(
     )
     h = min(cam.sample_step, FIT_STEP) if step is None else step
     for attempt in range(REFINEMENTS + 1):
-        phi = cam.sample_phi(h)
+        phi = cam.curve_phi(h)  # a linear cam's open edge: from φ = 0 to 2π, both ends
+        fit = _fit_closed if cam.closed else fit_open_profile
         try:
-            return _fit_closed(
+            return fit(
                 phi,
                 np.asarray(cam.offset(phi, offset).point),
                 exact=lambda p: cam.offset(p, offset).point,

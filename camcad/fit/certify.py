@@ -36,6 +36,7 @@ __all__ = [
     "ExactProfile",
     "certify",
     "certify_exact",
+    "certify_exact_open",
     "normal_distance",
     "project",
     "seam_jumps",
@@ -378,6 +379,87 @@ def certify_exact(
         s = np.insert(s, split + 1, _signed(curve, mid_pts, mid_foot))
         is_break = np.insert(is_break, split + 1, False)
     _, upper = _interval_bounds(phi, s, is_break)
+    dist = np.abs(s)
+    readonly(u, dist, phi)
+    return Certificate(foot=u, distance=dist, bound=float(np.max(upper)), phi=phi)
+
+
+def _open_bounds(
+    phi: FloatArray, s: FloatArray, is_break: NDArray[np.bool_]
+) -> tuple[FloatArray, FloatArray]:
+    """:func:`_interval_bounds` on an open node set: (n − 1) intervals, no wrap; both ends count as breaks."""
+    h = np.diff(phi)
+    dd = np.full(len(phi), np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dd[1:-1] = np.abs(2.0 * ((s[2:] - s[1:-1]) / h[1:] - (s[1:-1] - s[:-2]) / h[:-1]) / (h[1:] + h[:-1]))
+    dd = np.where(is_break, np.nan, dd)
+    m = np.fmax(dd[:-1], dd[1:])
+    m = np.where(np.isnan(m), np.inf, m)
+    top = np.maximum(np.abs(s[:-1]), np.abs(s[1:]))
+    with np.errstate(invalid="ignore"):
+        upper = top + CERT_SAFETY * m * h**2 / 8.0
+    return h, np.where(h > CERT_MIN_STEP, upper, top)
+
+
+def certify_exact_open(
+    curve: BSplineCurve,
+    exact: ExactProfile,
+    points: FloatArray,
+    feet: FloatArray,
+    *,
+    rel_tol: float = CERT_REL_TOL,
+) -> Certificate:
+    """Bound the distance from a whole exact open curve to a clamped curve (a linear cam's profile).
+
+    As :func:`certify_exact`, with ``exact.phi`` running from the curve's
+    start to its end (both included) and no wrap: the same branch and bound
+    on the signed foot-point distance, started from the samples, the
+    breakpoints, ``CERT_NODES_PER_SPAN`` points per knot span and per
+    stretch between breakpoints and a 1° grid, splitting every interval
+    whose bound exceeds (1 + rel_tol) times the largest distance found.
+    ``exact.point`` is called at angles in [φ_0, φ_end], unwrapped.
+    """
+    a, b = curve.domain
+    pts = np.asarray(points, dtype=float)
+    feet = np.maximum.accumulate(np.asarray(feet, dtype=float))
+    phi_s = np.asarray(exact.phi, dtype=float)
+    phi0, phi1 = float(phi_s[0]), float(phi_s[-1])
+    breaks = np.asarray(exact.breaks, dtype=float)
+    breaks = breaks[(breaks > phi0) & (breaks < phi1)]
+    knots = np.unique(curve.knots[(curve.knots >= a) & (curve.knots <= b)])
+    frac = np.arange(CERT_NODES_PER_SPAN) / CERT_NODES_PER_SPAN
+    u_nodes = (knots[:-1, None] + np.diff(knots)[:, None] * frac).ravel()
+    grid = np.linspace(phi0, phi1, int(np.ceil((phi1 - phi0) / CERT_GRID_STEP)) + 1)
+    b_ext = np.sort(np.append(breaks, [phi0, phi1]))
+    pieces = (b_ext[:-1, None] + np.diff(b_ext)[:, None] * frac).ravel()
+    cand = np.concatenate((breaks, np.interp(u_nodes, feet, phi_s), grid, pieces))
+    cand = np.unique(cand[(cand > phi0) & (cand < phi1)])
+    cand = cand[np.r_[True, np.diff(cand) > CERT_MIN_STEP]]
+    at = np.clip(np.searchsorted(phi_s, cand), 1, len(phi_s) - 1)
+    cand = cand[np.minimum(phi_s[at] - cand, cand - phi_s[at - 1]) > CERT_MIN_STEP]
+    new_pts = np.asarray(exact.point(cand), dtype=float)
+    new_foot = project(curve, new_pts, np.interp(cand, phi_s, feet)).foot
+    phi = np.concatenate((phi_s, cand))
+    order = np.argsort(phi, kind="stable")
+    phi = phi[order]
+    u = np.concatenate((feet, new_foot))[order]
+    s = np.concatenate((_signed(curve, pts, feet), _signed(curve, new_pts, new_foot)))[order]
+    is_break = np.any(
+        np.abs(phi[:, None] - np.append(breaks, [phi0, phi1])[None, :]) <= CERT_MIN_STEP, axis=1
+    )
+    for _ in range(CERT_MAX_LEVELS):
+        h, upper = _open_bounds(phi, s, is_break)
+        split = np.flatnonzero(upper > np.max(np.abs(s)) * (1.0 + rel_tol))
+        if split.size == 0:
+            break
+        mid = phi[split] + 0.5 * h[split]
+        mid_pts = np.asarray(exact.point(mid), dtype=float)
+        mid_foot = project(curve, mid_pts, 0.5 * (u[split] + u[split + 1])).foot
+        phi = np.insert(phi, split + 1, mid)
+        u = np.insert(u, split + 1, mid_foot)
+        s = np.insert(s, split + 1, _signed(curve, mid_pts, mid_foot))
+        is_break = np.insert(is_break, split + 1, False)
+    _, upper = _open_bounds(phi, s, is_break)
     dist = np.abs(s)
     readonly(u, dist, phi)
     return Certificate(foot=u, distance=dist, bound=float(np.max(upper)), phi=phi)

@@ -17,6 +17,7 @@ import numpy as np
 
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
+from camcad.errors import DesignError
 from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import (
     LineElement,
@@ -26,6 +27,7 @@ from camcad.geometry.envelope import (
     point_envelope,
     pressure_angle,
     to_cam,
+    translation_envelope,
 )
 from camcad.geometry.followers import Follower
 from camcad.geometry.followers.tied import TiedRoller
@@ -100,7 +102,7 @@ class CamState:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Cam:
-    """A disc cam driving a follower.
+    """A disc cam, or a linear cam (a plate translating along x), driving a follower.
 
     Attributes
     ----------
@@ -112,6 +114,13 @@ class Cam:
         The design's follower table (kind, roller radius r_f [mm], offset e [mm]).
     rotation
         ``CCW`` (default) or ``CW``.
+    stroke_length
+        None: a disc cam turning about its axis. Else a linear cam: the plate
+        moves by ``stroke_length`` L [mm] towards −x per cycle of the motion
+        (φ from 0 to 2π), so a machine point M(φ) is at M(φ) + (Lφ/2π, 0) in
+        the plate's frame (:func:`camcad.geometry.envelope.translation_envelope`;
+        :mod:`camcad.geometry.linear`); ``base_radius`` is then the base line's
+        height above y = 0 and the profile is open, from x = 0 to x = L.
 
     Notes
     -----
@@ -130,6 +139,7 @@ class Cam:
     rotation: Rotation = Rotation.CCW
     sample_step: float = math.radians(0.1)
     conjugate: ConjugateSpec | None = None  # set: this is the pair's second plate, driving the tied roller
+    stroke_length: float | None = None  # set: a linear cam, L [mm] of plate travel per cycle
     _memo: dict[str, Any] = field(  # the follower module, and the last sample grid's motion and state
         default_factory=dict, init=False, compare=False, hash=False, repr=False
     )
@@ -204,6 +214,54 @@ class Cam:
         return self.follower.eccentricity
 
     @property
+    def closed(self) -> bool:
+        """Whether the profile is a closed curve (a disc cam); a linear cam's runs open from x = 0 to L."""
+        return self.stroke_length is None
+
+    @property
+    def travel_rate(self) -> float | None:
+        """A linear cam's plate travel per radian of the motion, c = L/2π [mm/rad]; None for a disc cam."""
+        return None if self.stroke_length is None else self.stroke_length / TWO_PI
+
+    def frame_angle(self, phi: ArrayLike) -> FloatArray:
+        """The angle [rad] the cam frame is turned by at motion angles φ: φ on a disc, 0 on a linear cam.
+
+        ``to_cam(cam.frame_angle(φ), v, -cam.sigma)`` turns cam-frame vectors into the machine frame.
+        """
+        angle = np.asarray(phi, dtype=float)
+        out: FloatArray = angle if self.stroke_length is None else np.zeros_like(angle)
+        return out
+
+    def to_machine(self, phi: ArrayLike, vectors: FloatArray) -> FloatArray:
+        """(n, 2) cam-frame vectors at motion angles φ (n,) [rad] seen in the machine frame."""
+        return to_cam(self.frame_angle(phi), vectors, -self.sigma)
+
+    def surface_rate(self, points: FloatArray) -> FloatArray:
+        """(n, 2) velocity of the cam's material at machine points (n, 2) [mm], per radian of motion [mm/rad].
+
+        A disc turning at σ: σ ẑ × P; a linear cam's plate: (−c, 0) everywhere, c = L/2π.
+        """
+        pts = np.asarray(points, dtype=float)
+        if self.stroke_length is None:
+            out: FloatArray = self.sigma * np.column_stack((-pts[:, 1], pts[:, 0]))
+            return out
+        return np.column_stack((np.full(len(pts), -self.stroke_length / TWO_PI), np.zeros(len(pts))))
+
+    def _point_envelope(self, m: Motion, element: PointElement) -> tuple[CurveSample, FloatArray]:
+        """The path of a roller centre in the cam frame and its dρ/dφ: turned by a disc, shifted by a bar."""
+        if self.stroke_length is None:
+            return point_envelope(m.phi, element, self.sigma)
+        return translation_envelope(m.phi, element, self.stroke_length / TWO_PI)
+
+    def _line_envelope(self, m: Motion, element: LineElement) -> tuple[CurveSample, FloatArray]:
+        if self.stroke_length is not None:  # the design check refuses it (geometry.linear)
+            raise DesignError(
+                "follower.type",
+                "a flat face has no envelope on a linear cam (it does not turn relative to it)",
+            )
+        return line_envelope(m.phi, element, self.sigma)
+
+    @property
     def sigma(self) -> float:
         """+1 for a counter-clockwise cam, −1 for a clockwise one."""
         return 1.0 if self.rotation is Rotation.CCW else -1.0
@@ -247,6 +305,15 @@ class Cam:
         """Cam angles in [0, 2π) at ``step`` [rad] (default: the design's) plus every breakpoint."""
         return self.program.sample_phi(self.sample_step if step is None else step)
 
+    def curve_phi(self, step: float | None = None) -> FloatArray:
+        """:meth:`sample_phi`, and for an open profile (a linear cam's edge) its end φ = 2π too."""
+        phi = self.sample_phi(step)
+        if self.closed:
+            return phi
+        out: FloatArray = np.append(phi, TWO_PI)
+        readonly(out)
+        return out
+
     # -- curves -------------------------------------------------------------
 
     def _element(self, phi: ArrayLike, side: Side) -> tuple[Motion, PointElement | LineElement]:
@@ -261,7 +328,7 @@ class Cam:
         follower axis). ``side`` picks the one-sided limit at joints.
         """
         m = self.motion(phi, side=side)
-        return point_envelope(m.phi, self.kinematics.trace(m), self.sigma)[0]
+        return self._point_envelope(m, self.kinematics.trace(m))[0]
 
     def _base_curve(self, phi: ArrayLike, side: Side) -> tuple[CurveSample, FloatArray, float]:
         """The curve offsets are taken from, its dρ/dφ, and the profile's distance from it [mm].
@@ -271,9 +338,9 @@ class Cam:
         """
         m, element = self._element(phi, side)
         if isinstance(element, PointElement):
-            base, drho = point_envelope(m.phi, element, self.sigma)
+            base, drho = self._point_envelope(m, element)
             return base, drho, -self.roller_radius
-        base, drho = line_envelope(m.phi, element, self.sigma)
+        base, drho = self._line_envelope(m, element)
         return base, drho, 0.0
 
     def offset(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
@@ -296,7 +363,7 @@ class Cam:
         base, drho, profile_at = self._base_curve(phi, side)
         profile = offset_curve(base, drho, profile_at)
         driven = base.point if self.has_pitch_curve else profile.point
-        return profile, to_cam(profile.phi, driven, -self.sigma)
+        return profile, self.to_machine(profile.phi, driven)
 
     def state(self, phi: ArrayLike, *, side: Side = "right") -> CamState:
         """Everything at cam angles φ [rad] from one evaluation: motion, base curve, profile, α, contact.
@@ -319,17 +386,18 @@ class Cam:
     def _state(self, phi: ArrayLike, side: Side) -> CamState:
         m, element = self._element(phi, side)
         if isinstance(element, PointElement):
-            base, drho = point_envelope(m.phi, element, self.sigma)
+            base, drho = self._point_envelope(m, element)
             profile = offset_curve(base, drho, -self.roller_radius)
             driven = base.point
         else:
-            base, drho = line_envelope(m.phi, element, self.sigma)
+            base, drho = self._line_envelope(m, element)
             profile = base
             driven = profile.point
         guide = self.kinematics.guide
-        driven_machine = to_cam(m.phi, driven, -self.sigma)
-        alpha = pressure_angle(m.phi, profile.normal, driven_machine, guide, self.sigma)
-        contact = to_cam(m.phi, profile.point, -self.sigma)
+        turned = self.frame_angle(m.phi)
+        driven_machine = to_cam(turned, driven, -self.sigma)
+        alpha = pressure_angle(turned, profile.normal, driven_machine, guide, self.sigma)
+        contact = to_cam(turned, profile.point, -self.sigma)
         lever = None
         if guide.pivot is not None:
             arm = driven_machine - np.asarray(guide.pivot)
@@ -370,7 +438,8 @@ class Cam:
         picks the one-sided limit at joints.
         """
         profile, driven = self._driven_point(phi, side)
-        return pressure_angle(profile.phi, profile.normal, driven, self.kinematics.guide, self.sigma)
+        turned = self.frame_angle(profile.phi)
+        return pressure_angle(turned, profile.normal, driven, self.kinematics.guide, self.sigma)
 
     def contact_offset(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
         """Where the contact sits on the follower [mm] (:meth:`Follower.contact_position`).
@@ -383,7 +452,7 @@ class Cam:
         """
         m = self.motion(phi, side=side)
         profile = self.profile(phi, side=side)
-        contact = to_cam(profile.phi, profile.point, -self.sigma)
+        contact = self.to_machine(profile.phi, profile.point)
         out = self.kinematics.contact_position(contact, m)
         readonly(out)
         return out

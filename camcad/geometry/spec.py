@@ -13,6 +13,7 @@ __all__ = [
     "ConjugateSpec",
     "FollowerSpec",
     "GrooveSpec",
+    "LinearSpec",
     "Rotation",
 ]
 
@@ -30,6 +31,7 @@ class CamStyle(enum.Enum):
     PLATE = "plate"
     GROOVE = "groove"
     CONJUGATE = "conjugate"
+    LINEAR = "linear"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -38,6 +40,22 @@ class GrooveSpec:
 
     depth: float = 10.0
     clearance: float = 0.02
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class LinearSpec:
+    """A linear cam's bar (the ``[linear]`` table): lengths mm, speed mm/s.
+
+    ``stroke_length`` L: the bar's travel per cycle of the motion program (its
+    360°), and the bar's length; ``bar_height``: the bar's height from its
+    bottom edge to the base line (the profile at s = 0); ``speed_mm_s``: the
+    bar's speed, which sets the cycle time L/v of the dynamics (None: the
+    cycle rate is ``cam.speed_rpm`` cycles per minute).
+    """
+
+    stroke_length: float = 0.0
+    bar_height: float = 20.0
+    speed_mm_s: float | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

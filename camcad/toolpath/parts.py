@@ -9,6 +9,7 @@ or a rotary table (:func:`camcad.toolpath.rotary.plan_rotary`).
 from __future__ import annotations
 
 from camcad.geometry.families import Part
+from camcad.toolpath.bar import plan_bar
 from camcad.toolpath.groove import plan_groove
 from camcad.toolpath.plan import Toolpath, plan_toolpath
 from camcad.toolpath.rotary import RotaryToolpath, plan_rotary
@@ -37,6 +38,8 @@ def plan_part(
             clearance=pocket.clearance,
             bore=bore,
         )
+    if part.bar is not None:  # a linear cam's bar: its open edge, cut on an XY mill
+        return plan_bar(part.cam, part.bar, spec, name=title, thickness=thickness)
     if spec.machine is Machine.ROTARY:  # X + A/C in inverse time
         return plan_rotary(part.cam, spec, name=title, thickness=thickness)
     return plan_toolpath(part.cam, spec, name=title, thickness=thickness, bore=bore)

@@ -6,6 +6,7 @@ See :mod:`camcad.geometry.families.base` for what a family yields.
 from __future__ import annotations
 
 from camcad.geometry.families.base import (
+    Bar,
     CamFamily,
     Drive,
     FamilyOptions,
@@ -17,11 +18,13 @@ from camcad.geometry.families.base import (
 )
 from camcad.geometry.families.conjugate import CONJUGATE
 from camcad.geometry.families.groove import GROOVE
+from camcad.geometry.families.linear import LINEAR
 from camcad.geometry.families.plate import PLATE
 from camcad.geometry.spec import CamStyle
 
 __all__ = [
     "FAMILIES",
+    "Bar",
     "CamFamily",
     "Drive",
     "FamilyOptions",
@@ -37,6 +40,7 @@ FAMILIES: dict[CamStyle, CamFamily] = {
     CamStyle.PLATE: PLATE,
     CamStyle.GROOVE: GROOVE,
     CamStyle.CONJUGATE: CONJUGATE,
+    CamStyle.LINEAR: LINEAR,
 }
 """Each ``cam.style`` and its family."""
 

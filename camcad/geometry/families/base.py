@@ -24,9 +24,19 @@ from typing import Any, Protocol, TypedDict
 
 from camcad.findings import Finding
 from camcad.geometry.cam import Cam
-from camcad.geometry.spec import ConjugateSpec, GrooveSpec
+from camcad.geometry.spec import ConjugateSpec, GrooveSpec, LinearSpec
 
-__all__ = ["CamFamily", "Drive", "FamilyOptions", "Flank", "Part", "PartCheck", "PartResults", "Pocket"]
+__all__ = [
+    "Bar",
+    "CamFamily",
+    "Drive",
+    "FamilyOptions",
+    "Flank",
+    "Part",
+    "PartCheck",
+    "PartResults",
+    "Pocket",
+]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -39,6 +49,7 @@ class FamilyOptions:
 
     groove: GrooveSpec = field(default_factory=GrooveSpec)
     conjugate: ConjugateSpec = field(default_factory=ConjugateSpec)
+    linear: LinearSpec = field(default_factory=LinearSpec)
     outer_radius: float | None = None
     hole_radius: float = 0.0
 
@@ -98,6 +109,21 @@ class Pocket:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class Bar:
+    """A bar cut along its cam's open edge (a linear cam), in the cam's frame [mm].
+
+    The bar runs from x = ``x0`` (the edge's start, φ = 0) to ``x0 + length``
+    (its end, φ = 2π); its bottom edge is the line y = ``bottom``. Its
+    outline is the edge, the end at x0 + length down to the bottom, the
+    bottom back and the end at x0 up to the edge's start.
+    """
+
+    x0: float
+    length: float
+    bottom: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Part:
     """One part a cam family makes, and what every later stage needs of it.
 
@@ -121,6 +147,9 @@ class Part:
     pocket
         None: a plate, cut along its outline. Else the blank and the pocket
         between two flanks (a groove cam).
+    bar
+        None: a disc. Else the bar whose top edge is the cam's open profile
+        (a linear cam).
     checks
         The family's own checks of the part (a groove's flank checks).
     """
@@ -131,6 +160,7 @@ class Part:
     drive_sign: float = 1.0
     made: bool = True
     pocket: Pocket | None = None
+    bar: Bar | None = None
     checks: tuple[PartCheck, ...] = ()
 
     @property
