@@ -352,7 +352,7 @@ def analyse_geometry(
     undercut_finding = Finding(
         kind="undercut" if cam.has_pitch_curve else "cusp",
         severity=Severity.HARD,
-        field="cam.base_radius",
+        field="cam.base_radius" if cam.closed else "linear.stroke_length",
         message=str(err),
         angle=undercut.worst_angle,
         value=undercut.worst,
@@ -615,6 +615,14 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
     """The error for an undercut analysis, with the smallest base radius that removes it."""
     cam, uc = analysis.cam, analysis.undercut
     assert uc is not None
+    if not cam.closed:  # a linear cam: the base line's height does not change the edge's curvature
+        message = (
+            f"linear.stroke_length: undercut at {format_ranges(list(uc.ranges))}: the pitch line's convex "
+            f"radius of curvature falls to {uc.worst:.3f} mm {uc.where()}, below the "
+            f"{cam.kinematics.words.radius} {cam.roller_radius:g} mm, so the edge loops; lengthen the "
+            f"stroke (now {cam.stroke_length:g} mm), {cam.kinematics.words.smaller} or use a gentler law"
+        )
+        return UndercutError(message, phi_range=uc.ranges[0], worst=uc.worst, suggested_base_radius=None)
     sized = min_base_radius(cam, min_curvature_radius=min_curvature_radius)
     suggestion = math.ceil(sized.base_radius / _SUGGEST_ROUND_MM) * _SUGGEST_ROUND_MM
     where = format_ranges(list(uc.ranges))
