@@ -263,10 +263,10 @@ def follower_drawings(analysis: Analysis, reach: float, *, cam: Cam | None = Non
     for phi, sketch in zip(phis, cam.kinematics.sketch(cam.motion(phis), size=reach), strict=True):
 
         def seen(points: np.ndarray, phi: float = phi) -> np.ndarray:
-            return to_cam(np.full(len(points), phi), np.asarray(points, dtype=float), cam.sigma)
+            return cam.seen_from_cam(np.full(len(points), phi), np.asarray(points, dtype=float))
 
         tip = seen(sketch.tip[None, :])[0]
-        dx, dy = to_cam(np.array([phi]), sketch.heading[None, :], cam.sigma)[0]
+        dx, dy = to_cam(cam.frame_angle(np.array([phi])), sketch.heading[None, :], cam.sigma)[0]
         out.append(
             FollowerDrawing(
                 phi_deg=math.degrees(phi),
@@ -340,8 +340,14 @@ def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
         reach = max(reach, pocket.outer_radius)
     fig = figure((size, size), left=0.7, bottom=0.5, top=0.15, right=0.15)
     ax = fig.subplots()
+    bar = analysis.parts[0].part.bar
     if pocket is not None:
         _draw_pocket(ax, analysis, pocket)
+    elif bar is not None:  # a linear cam: the bar under its edge
+        x1 = bar.x0 + bar.length
+        outline = np.vstack((profile, [[x1, bar.bottom], [bar.x0, bar.bottom]]))
+        shape(ax, Polygon(outline, closed=True, facecolor="#dbe6f1", edgecolor="#1f3b57", linewidth=1.5))
+        ax.plot([], [], color="#1f3b57", linewidth=1.5, label="bar (its top edge is the cam)")
     else:
         shape(ax, Polygon(profile, closed=True, facecolor="#dbe6f1", edgecolor="#1f3b57", linewidth=1.5))
         ax.plot([], [], color="#1f3b57", linewidth=1.5, label="cam profile")
@@ -355,18 +361,46 @@ def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
         hole = bore_outline(spec.bore, spec.keyway_width, spec.keyway_depth)
         shape(ax, Polygon(hole, closed=True, facecolor="white", edgecolor="#1f3b57", linewidth=1.1))
         ax.plot([], [], color="#1f3b57", linewidth=1.1, label=f"bore ⌀{spec.bore:g} mm")
-    ax.plot(*np.vstack((pitch, pitch[:1])).T, color="#d9731a", linewidth=1.0, linestyle="--",
+    closing = pitch[:1] if cam.closed else pitch[:0]  # a linear cam's pitch line runs open
+    ax.plot(*np.vstack((pitch, closing)).T, color="#d9731a", linewidth=1.0, linestyle="--",
             label=trace_name(analysis))  # fmt: skip
-    shape(
-        ax, Circle((0.0, 0.0), cam.base_radius, fill=False, edgecolor="#7f7f7f", linestyle=":", linewidth=1.0)
-    )
-    ax.plot([], [], color="#7f7f7f", linestyle=":", label=f"base circle r = {cam.base_radius:g} mm")
+    if cam.closed:
+        shape(
+            ax,
+            Circle(
+                (0.0, 0.0), cam.base_radius, fill=False, edgecolor="#7f7f7f", linestyle=":", linewidth=1.0
+            ),
+        )
+        ax.plot([], [], color="#7f7f7f", linestyle=":", label=f"base circle r = {cam.base_radius:g} mm")
+    else:
+        ax.plot(profile[[0, -1], 0], [cam.base_radius] * 2, color="#7f7f7f", linestyle=":", linewidth=1.0,
+                label=f"base line y = {cam.base_radius:g} mm")  # fmt: skip
     tick = 0.04 * reach
     ax.plot([-tick, tick], [0.0, 0.0], color="black", linewidth=0.8)
     ax.plot([0.0, 0.0], [-tick, tick], color="black", linewidth=0.8)
     far = _draw_followers(ax, analysis, reach)
     for plate in further:
         far = max(far, _draw_followers(ax, analysis, reach, cam=plate))
+    if bar is not None:  # the bar slides towards −x: an arrow below it
+        y = bar.bottom - 0.08 * reach
+        shape(ax, FancyArrowPatch((bar.x0 + 0.6 * bar.length, y), (bar.x0 + 0.4 * bar.length, y),
+                                  arrowstyle="-|>", mutation_scale=12, color="#333333"))  # fmt: skip
+        ax.text(bar.x0 + 0.5 * bar.length, y - 0.04 * reach, "v", fontsize=FONT + 2, ha="center", va="top")
+        plan_axes(ax, far)
+        ax.autoscale(tight=False)  # the bar's own extent, not a square round an axis
+        ax.margins(0.08)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.legend(fontsize=FONT - 1, loc="upper right", framealpha=0.9)
+        return Plot(
+            key="profile",
+            title="Cam profile (to scale)",
+            caption=f"Bar frame at φ = 0 (follower on +y, bar sliding towards −x): "
+            f"{cam.kinematics.describe()}, drawn where it meets the bar at φ = "
+            + ", ".join(f"{a:g}°" for a in FOLLOWER_ANGLES_DEG)
+            + "."
+            + family_caption(analysis),
+            svg=svg(fig),
+        )
     # direction of rotation, as an arc just outside the profile
     sign = 1.0 if cam.rotation.value == "ccw" else -1.0
     r_arrow = 1.08 * float(np.hypot(*profile.T).max())

@@ -210,16 +210,26 @@ def toolpath_layers(toolpath: Toolpath) -> dict[str, list[FloatArray]]:
     return layers
 
 
+def part_outline(analysis: Analysis) -> FloatArray:
+    """(n, 2) the first part's outline in plan [mm]: its profile; a linear cam's bar adds its three sides."""
+    profile = np.asarray(analysis.geometry.profile.point, dtype=float)
+    bar = analysis.parts[0].part.bar
+    if bar is None:
+        return profile
+    out: FloatArray = np.vstack((profile, [[bar.x0 + bar.length, bar.bottom], [bar.x0, bar.bottom]]))
+    return out
+
+
 def toolpath_plot(analysis: Analysis) -> Plot | None:
     """The G-code toolpath in plan view over the exact profile; None without a toolpath."""
     path = analysis.toolpath
     if path is None:
         return None
-    geo, spec = analysis.geometry, analysis.design.cam
+    spec = analysis.design.cam
     layers = toolpath_layers(path)
     fig = figure((6.0, 6.0), left=0.7, bottom=0.5, top=0.15, right=0.15)
     ax = fig.subplots()
-    profile = np.asarray(geo.profile.point)
+    profile = part_outline(analysis)
     shape(ax, Polygon(profile, closed=True, facecolor="#e8eef5", edgecolor="black", linewidth=0.9))
     ax.plot([], [], color="black", linewidth=0.9, label="exact profile")
     if spec.bore > 0.0:
@@ -242,6 +252,12 @@ def toolpath_plot(analysis: Analysis) -> Plot | None:
         ax.add_collection(LineCollection(list(seen.values()), label=label, **look), autolim=False)
     reach = max(float(np.abs(np.vstack([*(np.vstack(v) for v in layers.values() if v), profile])).max()), 1.0)
     plan_axes(ax, 1.08 * reach)
+    if analysis.parts[0].part.bar is not None:  # a bar: its own extent, not a square round an axis
+        every = np.vstack([*(np.vstack(v) for v in layers.values() if v), profile])
+        (x0, y0), (x1, y1), pad = every.min(axis=0), every.max(axis=0), 0.05 * reach
+        ax.set_xlim(x0 - pad, x1 + pad)
+        ax.set_ylim(y0 - pad, y1 + pad)
+        ax.set_aspect("equal", adjustable="datalim")
     ax.legend(fontsize=FONT - 1, loc="lower right", framealpha=0.9)
     tabs = path.spec.tab_count if path.tab_top is not None else 0
     return Plot(
@@ -295,7 +311,7 @@ def solid_faces(analysis: Analysis) -> dict[str, object]:
     """
     spec = analysis.design.cam
     t = spec.thickness
-    outer = _outline(np.asarray(analysis.geometry.profile.point), _SOLID_POINTS)
+    outer = _outline(part_outline(analysis), _SOLID_POINTS)
     rings = [(outer, 1.0)]
     hole = None
     if spec.bore > 0.0:

@@ -95,7 +95,9 @@ from ezdxf import zoom
 from ezdxf.document import Drawing
 from ezdxf.layouts import Modelspace
 
+from camcad._typing import FloatArray
 from camcad.errors import ExportError
+from camcad.export._bar import bar_outline
 from camcad.export._outline import arc_outline, chord_budget, flatten_bspline, flatten_curve
 from camcad.export.atomic import atomic_write
 from camcad.export.spec import DxfSpec
@@ -118,6 +120,7 @@ __all__ = [
     "profile_arcs_document",
     "profile_document",
     "profile_poly_document",
+    "write_bar_dxfs",
     "write_part_dxfs",
     "write_profile_arcs_dxf",
     "write_profile_dxf",
@@ -648,8 +651,6 @@ def write_part_dxfs(
     flanks (their fits ``flank_fits``, on the flanks' layers); a plate as its outline.
     """
     if part.bar is not None:  # a linear cam's bar: its open edge and three sides (camcad.export.bar)
-        from camcad.export.bar import write_bar_dxfs
-
         return write_bar_dxfs(folder, part, fit=fit, plate=plate, options=options)
     curves: tuple[DxfCurve, ...] | None = None
     blank_radius: float | None = None
@@ -675,3 +676,78 @@ def write_part_dxfs(
             ("profile_arcs", write_profile_arcs_dxf),
         )
     ]
+
+
+PITCH_SAMPLES_PER_DEG = 4  # a linear cam's pitch-line vertices per degree of motion (dashed reference)
+
+
+def _open_spline(msp: Modelspace, curve: BSplineCurve, layer: str) -> None:
+    """An open SPLINE from the curve's poles and knots: non-rational, flags 0, no fit points."""
+    spline = msp.add_spline(degree=curve.degree, dxfattribs={"layer": layer})
+    spline.dxf.flags = 0
+    spline.control_points = [(float(x), float(y), 0.0) for x, y in curve.control_points]  # type: ignore[assignment]
+    spline.knots = [float(k) for k in curve.knots]  # type: ignore[assignment]
+
+
+def _pitch_line(cam: Cam) -> FloatArray:
+    """The roller centre's path over one cycle, sampled (a dashed reference line, not a cut curve)."""
+    phi = np.linspace(0.0, 2.0 * math.pi, 360 * PITCH_SAMPLES_PER_DEG + 1)
+    out: FloatArray = np.asarray(cam.pitch(phi).point, dtype=float)
+    return out
+
+
+def write_bar_dxfs(
+    folder: str | os.PathLike[str], part: Part, *, fit: ProfileFit, plate: Plate, options: DxfSpec
+) -> list[Path]:
+    """``profile{suffix}.dxf`` and ``profile_poly{suffix}.dxf`` of a linear cam's bar.
+
+    ``profile.dxf``: the edge as the fit's SPLINE and the bar's three sides
+    as LINEs, head to tail on ``CAM_PROFILE`` (one closed outline), the
+    pitch line dashed on ``PITCH_CURVE``, the annotation. ``profile_poly.dxf``:
+    the whole outline as one closed LWPOLYLINE within ``[dxf] chord_tolerance``
+    of the exact bar (the chord budget less the fit's certified error).
+    """
+    bar = part.bar
+    assert bar is not None  # the caller writes a bar's part here
+    cam = part.cam
+    outline = bar_outline(fit, bar)
+    tol = options.chord_tolerance
+    poly = flatten_bspline(outline, chord_budget(tol, fit.max_error, field="dxf.chord_tolerance"))
+    lo, hi = poly.min(axis=0), poly.max(axis=0)
+
+    doc, msp = _new_document()
+    _open_spline(msp, fit.clamped, "CAM_PROFILE")
+    ctrl = np.asarray(fit.clamped.control_points, dtype=float)
+    start, end = ctrl[0], ctrl[-1]
+    corners = [end, (end[0], bar.bottom), (start[0], bar.bottom), start]
+    for a, b in itertools.pairwise(corners):
+        msp.add_line(
+            (float(a[0]), float(a[1])), (float(b[0]), float(b[1])), dxfattribs={"layer": "CAM_PROFILE"}
+        )
+    if options.pitch_curve:
+        pitch = _pitch_line(cam)
+        _add_dashes(msp, pitch_dashes(pitch), "PITCH_CURVE")
+        hi = np.maximum(hi, pitch.max(axis=0))
+    box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+    if options.annotate:
+        lines = _annotation_lines(cam, plate, ())
+        lines.insert(
+            1, f"linear cam bar: stroke {bar.length:.3f} mm per cycle, bottom at y {bar.bottom:.3f} mm"
+        )
+        y = box[1] - 2.0 * TEXT_HEIGHT
+        for line in lines:
+            y -= 1.6 * TEXT_HEIGHT
+            msp.add_text(line, height=TEXT_HEIGHT, dxfattribs={"layer": "ANNOTATION"}).set_placement(
+                (box[0], y)
+            )
+        box = (box[0], y - TEXT_HEIGHT, box[2], box[3])
+    _frame(doc, box)
+    _add_sheet_frame(msp, box)
+    paths = [Path(folder) / f"profile{part.suffix}.dxf", Path(folder) / f"profile_poly{part.suffix}.dxf"]
+    atomic_write(paths[0], lambda tmp: save_reproducible(_audited(doc, "profile.dxf"), tmp))
+
+    doc2, msp2 = _new_document()
+    _add_closed_polyline(msp2, poly, "CAM_PROFILE")
+    _frame(doc2, (float(lo[0]), float(lo[1]), float(poly[:, 0].max()), float(poly[:, 1].max())))
+    atomic_write(paths[1], lambda tmp: save_reproducible(_audited(doc2, "profile_poly.dxf"), tmp))
+    return paths

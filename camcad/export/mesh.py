@@ -51,6 +51,7 @@ import numpy as np
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import ExportError
+from camcad.export._bar import bar_outline
 from camcad.export._outline import (
     analytic_area,
     bspline_area,
@@ -75,7 +76,7 @@ from camcad.geometry.plate import BoreOutline, Plate, circle_segments
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
-    from camcad.geometry.families import Part
+    from camcad.geometry.families import Bar, Part
 
 __all__ = [
     "MESH_FORMATS",
@@ -83,9 +84,11 @@ __all__ = [
     "GrooveSolidResult",
     "SolidResult",
     "TriangleMesh",
+    "bar_solid",
     "build_groove_solid",
     "build_solid",
     "threemf_bytes",
+    "write_bar_mesh",
     "write_meshes",
     "write_part_meshes",
 ]
@@ -501,8 +504,6 @@ def write_part_meshes(
     ``fit`` extruded (:func:`build_solid`).
     """
     if part.bar is not None:  # a linear cam's bar (camcad.export.bar)
-        from camcad.export.bar import write_bar_mesh
-
         return write_bar_mesh(outdir, part, fit=fit, plate=plate, options=options, formats=formats)
     solid: SolidResult | GrooveSolidResult
     if part.pocket is not None:
@@ -520,3 +521,62 @@ def write_part_meshes(
     else:
         solid = build_solid(fit, plate, options, cam=part.cam)
     return write_meshes(outdir, solid, formats, stem=f"cam{part.suffix}")
+
+
+def bar_solid(fit: ProfileFit, bar: Bar, plate: Plate, options: MeshSpec) -> SolidResult:
+    """The bar's outline flattened within ``[mesh] chord_tolerance`` and extruded: a checked closed solid.
+
+    Checks as for a plate (:func:`camcad.export.mesh.build_solid`): manifold3d
+    reports no error, genus 0, a closed consistently wound mesh whose volume
+    is the polygon's area times the thickness, and the polygon's area within
+    the chord bound of the outline spline's exact area.
+    """
+    tol = options.chord_tolerance
+    outline = bar_outline(fit, bar)
+    polygon = oriented(
+        np.asarray(flatten_bspline(outline, chord_budget(tol, fit.max_error, field="mesh.chord_tolerance"))),
+        ccw=True,
+    )
+    readonly(polygon)
+    section = manifold3d.CrossSection([polygon], manifold3d.FillRule.Positive)
+    solid = manifold3d.Manifold.extrude(section, plate.thickness)
+    mesh, genus = _checked_mesh(solid, 0, "the bar", "; the edge crosses the bar's sides")
+    area = float(
+        abs(np.sum(polygon[:, 0] * np.roll(polygon[:, 1], -1) - np.roll(polygon[:, 0], -1) * polygon[:, 1]))
+        / 2.0
+    )
+    spline = abs(bspline_area(outline))
+    bound = tol * bspline_length(outline) + AREA_ROUNDOFF * spline
+    if abs(area - spline) > bound:
+        raise ExportError(
+            f"solid check failed: the bar's polygon area {area:.9g} mm² differs from its spline's "
+            f"{spline:.9g} mm² by more than the chord bound {bound:.3g} mm²"
+        )
+    return SolidResult(
+        mesh=mesh,
+        volume=float(mesh.volume),
+        genus=genus,
+        holes=0,
+        thickness=plate.thickness,
+        chord_tolerance=tol,
+        contours=(polygon,),
+        polygon_area=area,
+        spline_area=spline,
+        profile_area=None,
+        chord_area_bound=bound,
+        fit_area_bound=None,
+    )
+
+
+def write_bar_mesh(
+    folder: str | os.PathLike[str],
+    part: Part,
+    *,
+    fit: ProfileFit,
+    plate: Plate,
+    options: MeshSpec,
+    formats: Sequence[str] = ("stl",),
+) -> list[Path]:
+    """``cam{suffix}.stl`` (and the other formats) of a linear cam's bar."""
+    assert part.bar is not None
+    return write_meshes(folder, bar_solid(fit, part.bar, plate, options), formats, stem=f"cam{part.suffix}")

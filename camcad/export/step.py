@@ -44,13 +44,14 @@ from typing import TYPE_CHECKING
 
 from camcad._version import __version__
 from camcad.errors import ExportError
+from camcad.export._bar import bar_outline
 from camcad.export._step_brep import Body, Entities, Outline, Prism, real, shell
 from camcad.export.atomic import atomic_write
 from camcad.geometry.plate import BoreOutline
 
 if TYPE_CHECKING:
     from camcad.fit.result import ProfileFit
-    from camcad.geometry.families import Part
+    from camcad.geometry.families import Bar, Part
     from camcad.geometry.plate import Plate
 
 __all__ = [
@@ -59,9 +60,11 @@ __all__ = [
     "Body",
     "Outline",
     "Prism",
+    "bar_body",
     "groove_body",
     "plate_body",
     "step_text",
+    "write_bar_step",
     "write_cam_step",
     "write_part_step",
     "write_step",
@@ -249,8 +252,6 @@ def write_part_step(
     """
     path = Path(folder) / f"cam{part.suffix}.step"
     if part.bar is not None:  # a linear cam's bar (camcad.export.bar)
-        from camcad.export.bar import write_bar_step
-
         return write_bar_step(folder, part, fit=fit, plate=plate)
     if part.pocket is not None:
         inner, outer = flank_fits
@@ -259,3 +260,14 @@ def write_part_step(
         )
         return write_step(path, [body])
     return write_cam_step(path, fit=fit, plate=plate, part=number)
+
+
+def bar_body(fit: ProfileFit, bar: Bar, plate: Plate) -> Body:
+    """The bar as a STEP body: its closed outline extruded by the plate thickness, named after the design."""
+    return Body(name=plate.name, prism=Prism(outer=bar_outline(fit, bar), height=plate.thickness))
+
+
+def write_bar_step(folder: str | os.PathLike[str], part: Part, *, fit: ProfileFit, plate: Plate) -> Path:
+    """``cam{suffix}.step`` of a linear cam's bar."""
+    assert part.bar is not None
+    return write_step(Path(folder) / f"cam{part.suffix}.step", [bar_body(fit, part.bar, plate)])

@@ -236,6 +236,17 @@ class Cam:
         """(n, 2) cam-frame vectors at motion angles φ (n,) [rad] seen in the machine frame."""
         return to_cam(self.frame_angle(phi), vectors, -self.sigma)
 
+    def seen_from_cam(self, phi: ArrayLike, points: FloatArray) -> FloatArray:
+        """(n, 2) machine-frame points at motion angles φ (n,) [rad] in the cam's frame [mm].
+
+        A disc turns them by −σφ; a linear cam's bar, moved by −cφ along x, shifts them by +cφ.
+        """
+        angle = np.asarray(phi, dtype=float)
+        out: FloatArray = to_cam(self.frame_angle(angle), np.asarray(points, dtype=float), self.sigma)
+        if self.stroke_length is not None:
+            out = out + np.column_stack((self.stroke_length / TWO_PI * angle, np.zeros_like(angle)))
+        return out
+
     def surface_rate(self, points: FloatArray) -> FloatArray:
         """(n, 2) velocity of the cam's material at machine points (n, 2) [mm], per radian of motion [mm/rad].
 

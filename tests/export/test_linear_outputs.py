@@ -117,6 +117,7 @@ def test_summary_reports_true_extremes_and_the_bar(tmp_path):
     assert geo["pressure_angle_max_deg"] == pytest.approx(math.degrees(math.atan(0.5)), abs=1e-9)
     assert geo["undercut"] is False
     lin = summary["linear"]
+    assert lin["pressure_angle_max_x_mm"] == pytest.approx(40.0, abs=1e-4)  # mid-rise: 60° of 360° × 240 mm
     assert lin["stroke_length_mm"] == 240.0
     assert lin["drive_force_max_N"] == pytest.approx(
         summary["dynamics"]["torque_max_Nmm"] / (240.0 / (2 * math.pi)), rel=1e-12

@@ -108,6 +108,11 @@ class LinearFamily:
             "bar_bottom_mm": bar.bottom,
             "travel_per_rad_mm": c,
         }
+        geo = result.geometry
+        for name in ("pressure_angle_max", "curvature_radius_min", "concave_radius_min"):
+            where = getattr(geo, name)
+            if where is not None:  # where along the bar the geometry's extremes lie: x = cφ
+                out[f"{name}_x_mm"] = c * float(where.phi)
         for key, ext in (("drive_force_min_N", dyn.torque_min), ("drive_force_max_N", dyn.torque_max)):
             if ext is not None:  # F = T/c: the work T dφ = F dx with dx = c dφ (c > 0 keeps the extremes)
                 out[key] = float(ext.value) / c
@@ -115,7 +120,7 @@ class LinearFamily:
 
     def caption(self, parts: Sequence[Part]) -> str:
         """The bar slides under the follower."""
-        return " The bar slides towards −x under the follower; one cycle is one stroke length."
+        return " One cycle of the motion is one stroke length of the bar."
 
 
 def _bar(cam: Cam, options: FamilyOptions) -> Bar:
