@@ -101,7 +101,7 @@ def contact_motion(
     if cam.kinematics.rolls:
         slip = np.zeros_like(p)
     else:
-        contact = cam.to_machine(p, np.asarray(prof.point, dtype=float))  # machine frame
+        contact = cam.machine_points(p, np.asarray(prof.point, dtype=float))  # machine frame
         t_machine = cam.to_machine(p, tangent)
         guide = cam.kinematics.guide
         direction = guide.driven(contact)

@@ -232,6 +232,17 @@ class Cam:
         out: FloatArray = angle if self.stroke_length is None else np.zeros_like(angle)
         return out
 
+    def machine_points(self, phi: ArrayLike, points: FloatArray) -> FloatArray:
+        """(n, 2) cam-frame points at motion angles φ (n,) [rad] in the machine frame [mm].
+
+        A disc turns them by +σφ; a linear cam's bar, moved by −cφ along x, shifts them by −cφ.
+        """
+        angle = np.asarray(phi, dtype=float)
+        out: FloatArray = to_cam(self.frame_angle(angle), np.asarray(points, dtype=float), -self.sigma)
+        if self.stroke_length is not None:
+            out = out - np.column_stack((self.stroke_length / TWO_PI * angle, np.zeros_like(angle)))
+        return out
+
     def to_machine(self, phi: ArrayLike, vectors: FloatArray) -> FloatArray:
         """(n, 2) cam-frame vectors at motion angles φ (n,) [rad] seen in the machine frame."""
         return to_cam(self.frame_angle(phi), vectors, -self.sigma)
@@ -374,7 +385,7 @@ class Cam:
         base, drho, profile_at = self._base_curve(phi, side)
         profile = offset_curve(base, drho, profile_at)
         driven = base.point if self.has_pitch_curve else profile.point
-        return profile, self.to_machine(profile.phi, driven)
+        return profile, self.machine_points(profile.phi, driven)
 
     def state(self, phi: ArrayLike, *, side: Side = "right") -> CamState:
         """Everything at cam angles φ [rad] from one evaluation: motion, base curve, profile, α, contact.
@@ -406,9 +417,9 @@ class Cam:
             driven = profile.point
         guide = self.kinematics.guide
         turned = self.frame_angle(m.phi)
-        driven_machine = to_cam(turned, driven, -self.sigma)
+        driven_machine = self.machine_points(m.phi, driven)
         alpha = pressure_angle(turned, profile.normal, driven_machine, guide, self.sigma)
-        contact = to_cam(turned, profile.point, -self.sigma)
+        contact = self.machine_points(m.phi, profile.point)
         lever = None
         if guide.pivot is not None:
             arm = driven_machine - np.asarray(guide.pivot)
@@ -463,7 +474,7 @@ class Cam:
         """
         m = self.motion(phi, side=side)
         profile = self.profile(phi, side=side)
-        contact = self.to_machine(profile.phi, profile.point)
+        contact = self.machine_points(profile.phi, profile.point)
         out = self.kinematics.contact_position(contact, m)
         readonly(out)
         return out

@@ -11,7 +11,7 @@ import numpy as np
 from camcad._typing import FloatArray, readonly
 from camcad.angles import TWO_PI, flagged_ranges, format_ranges
 from camcad.errors import UndercutError
-from camcad.extremes import SIDE_WORDS, Extreme, Kind, Quantity, Side, extremes_rows
+from camcad.extremes import SIDE_WORDS, Extreme, Kind, Quantity, Side, extremes_rows, maximum
 from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam, CamState
 from camcad.geometry.curves import CurveSample
@@ -374,6 +374,8 @@ def _pivot_clearance(cam: Cam, radius_max: Extreme) -> list[Finding]:
     pivot = cam.kinematics.guide.pivot
     if pivot is None:
         return []
+    if not cam.closed:
+        return _pivot_above_bar(cam, pivot)
     d = math.hypot(*pivot)
     if d > radius_max.value:
         return []
@@ -391,6 +393,33 @@ def _pivot_clearance(cam: Cam, radius_max: Extreme) -> list[Finding]:
             angle=radius_max.phi,
             value=d,
             limit=radius_max.value,
+            unit="mm",
+        )
+    ]
+
+
+def _pivot_above_bar(cam: Cam, pivot: tuple[float, float]) -> list[Finding]:
+    """A linear cam: the whole bar slides under the pivot, which must lie above the edge's highest point."""
+    top = maximum(
+        lambda p, side: np.asarray(cam.profile(p, side=side).point)[:, 1],
+        cam.sample_phi(),
+        [bp.phi for bp in cam.program.breakpoints],
+    )
+    if pivot[1] > top.value:
+        return []
+    return [
+        Finding(
+            kind="pivot clearance",
+            severity=Severity.HARD,
+            field="follower.pivot_distance",
+            message=(
+                f"follower.pivot_distance: the pivot at y = {pivot[1]:.3f} mm is not above the bar's edge, "
+                f"which reaches y = {top.value:.3f} mm {top.where()}: the bar would hit the arm's hub; "
+                "move the pivot up, or lower the lift or the base line"
+            ),
+            angle=top.phi,
+            value=pivot[1],
+            limit=top.value,
             unit="mm",
         )
     ]

@@ -190,3 +190,38 @@ def test_cli_exit_2_names_the_field(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "linear.stroke_length" in err and "-1" in err
     assert "Traceback" not in err
+
+
+ARM = {"type": "oscillating-roller", "roller_radius": RF, "pivot_distance": 90.0, "arm_length": 70.0}
+
+
+def test_oscillating_rollers_pressure_angle_from_the_pitch_lines_numerical_normal():
+    """|α| is the angle between the pitch line's normal and the arm's perpendicular at the roller centre."""
+    cam = bar_cam(linear_data(follower=ARM))
+    pivot = np.asarray(cam.kinematics.guide.pivot)
+    phi = np.linspace(0.05, 2.05, 4001)  # inside the rise
+    pitch = np.asarray(cam.pitch(phi).point)
+    tangent = np.gradient(pitch, phi, axis=0, edge_order=2)
+    normal = np.column_stack((-tangent[:, 1], tangent[:, 0]))
+    centre = np.asarray(cam.kinematics.element(cam.motion(phi)).m0)  # machine frame (the arm does not move x)
+    arm = centre - pivot
+    across = np.column_stack((-arm[:, 1], arm[:, 0]))
+    cos = np.abs(np.einsum("ij,ij->i", normal, across)) / (np.hypot(*normal.T) * np.hypot(*across.T))
+    assert_allclose(np.abs(cam.state(phi).pressure_angle)[5:-5], np.arccos(cos)[5:-5], atol=1e-6)
+
+
+def test_a_pivot_below_the_bars_edge_is_a_hard_finding():
+    low = dict(ARM, pivot_distance=50.0)
+    result = analyse(parse_design(linear_data(follower=low)), fit=False, toolpath=False, strict=False)
+    (hit,) = [f for f in result.findings if f.kind == "pivot clearance"]
+    assert hit.hard and hit.field == "follower.pivot_distance"
+    top = float(
+        np.max(
+            np.asarray(bar_cam(linear_data(follower=low)).profile(np.linspace(0, 2 * np.pi, 72001)).point)[
+                :, 1
+            ]
+        )
+    )
+    assert hit.limit == pytest.approx(top, abs=1e-6)
+    high = analyse(parse_design(linear_data(follower=ARM)), fit=False, toolpath=False, strict=False)
+    assert not [f for f in high.findings if f.kind == "pivot clearance"]
