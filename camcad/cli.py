@@ -544,6 +544,7 @@ def _cmd_tolerance(args: argparse.Namespace) -> int:
         jobs=jobs,
         scheduler=args.scheduler,
         progress=None if args.quiet or not sys.stderr.isatty() else report,
+        setup=design.dynamics_setup(),
     )
     summary = result.summary
     unit = summary["lift_unit"]
