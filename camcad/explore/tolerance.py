@@ -480,6 +480,40 @@ def _band_figure(bands: Bands, key: str, label: str, envelope: tuple[FloatArray,
     return base64.b64encode(svg(fig)).decode("ascii")
 
 
+def _peaks_table(summary: Mapping[str, Any], unit: str, pct_head: str) -> list[str]:
+    """The peaks' section: each figure's design value and its Monte-Carlo percentiles."""
+    rows = []
+    for key, label in (
+        ("peak_acceleration", f"peak |acceleration| [{unit}/rad²]"),
+        ("peak_pressure_angle", "peak |pressure angle| [°]"),
+        ("contact_stress", "peak contact stress [MPa]"),
+    ):
+        fig = summary.get(key) or {}
+        nominal = fig.get("nominal")
+        cells = "".join(f'<td class="n">{v:.5g}</td>' for v in (fig.get("percentiles") or []) if pct_head)
+        shown = "—" if nominal is None else f"{nominal:.5g}"
+        rows.append(f'<tr><td>{_e(label)}</td><td class="n">{shown}</td>{cells}</tr>')
+    out = [
+        "<h2>Peaks of the made cams</h2>",
+        f"<table><tr><th>figure</th><th>design</th>{pct_head}</tr>" + "".join(rows) + "</table>",
+    ]
+    note = summary.get("contact_stress_note")
+    if note:
+        out.append(f"<p>Contact stress {_e(note)}.</p>")
+    how = summary.get("evaluation") or {}
+    if how.get("method") == "quadratic":
+        worst = "; ".join(
+            f"{_e(k)} {'—' if v is None else f'{v:.2g}'}"
+            for k, v in how["max_abs_difference_from_exact"].items()
+        )
+        out.append(
+            f"<p>Evaluated by quadratics fitted on {how['stencil_variants']} re-solved made cams; on "
+            f"{how['certified_variants']} of these made cams re-solved exactly the largest differences were: "
+            f"{worst}.</p>"
+        )
+    return out
+
+
 def tolerance_page(cam: Cam, spec: ToleranceSpec, summary: Mapping[str, Any], *, table: str) -> str:
     """The HTML text of ``tolerance.html``."""
     unit = summary["lift_unit"]
@@ -514,6 +548,7 @@ def tolerance_page(cam: Cam, spec: ToleranceSpec, summary: Mapping[str, Any], *,
         + "".join(dwell_rows)
         + "</table>",
     ]
+    body += _peaks_table(summary, unit, pct_head if env else "")
     alloc = summary.get("allocation")
     if alloc is not None:
         items = "".join(

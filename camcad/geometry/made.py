@@ -197,12 +197,14 @@ def made_motion(
     sigma = mount0.sigma
     angle = sigma * (phi_all - phase)  # the cam's turn: R(σ(φ − δ))
     u = phi_all - phase
-    for _ in range(_ITERATIONS):
+    done = np.zeros(u.shape, dtype=bool)
+    for _ in range(_ITERATIONS):  # each point stops on its own: a batch gives each variant's own bytes
         curve = made_curve(cam, u, w, form)
         g, g_u = _condition(mount0, mounts, curve, angle)
         step = np.clip(g / g_u, -_MAX_STEP, _MAX_STEP)
-        u = u - step
-        if np.all(np.abs(step) < 1e-13):
+        u = np.where(done, u, u - step)
+        done |= np.abs(step) < 1e-13
+        if np.all(done):
             break
     curve = made_curve(cam, u, w, form)
     g, g_u = _condition(mount0, mounts, curve, angle)

@@ -33,12 +33,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from camcad._typing import FloatArray, readonly
 from camcad.geometry.cam import Cam
 from camcad.geometry.made import made_motion
 from camcad.geometry.sensitivity import Tol
 from camcad.inspect.tolerance import (
+    Quantity,
     Tolerance,
     _golden,
     _grid,
@@ -100,7 +102,8 @@ class Quadratic:
     def fit(x: FloatArray, values: FloatArray) -> Quadratic:
         """Least-squares quadratic through ``values`` (S, F) at the stencil points x (S, K)."""
         basis = np.column_stack(_features(x))
-        coef, *_ = np.linalg.lstsq(basis, values, rcond=None)
+        solved, *_ = np.linalg.lstsq(basis, values, rcond=None)
+        coef: FloatArray = np.asarray(solved, dtype=float)
         readonly(coef)
         return Quadratic(coef)
 
@@ -157,13 +160,13 @@ class Response:
         return dwell, peaks["acceleration"], peaks["pressure_angle"], peaks["stress"]
 
 
-def _candidates(values: FloatArray) -> FloatArray:
+def _candidates(values: FloatArray) -> npt.NDArray[np.intp]:
     """Indices of the grid's local maxima within :data:`_KEEP` of the largest, largest first."""
     if np.all(np.isnan(values)):
         return np.zeros(0, dtype=int)
     local = (values >= np.roll(values, 1)) & (values >= np.roll(values, -1))
     keep = np.flatnonzero(local & (values >= _KEEP * np.max(values)))
-    out: FloatArray = keep[np.argsort(-values[keep], kind="stable")][:_MAX_CANDIDATES]
+    out: npt.NDArray[np.intp] = keep[np.argsort(-values[keep], kind="stable")][:_MAX_CANDIDATES]
     return out
 
 
@@ -202,9 +205,10 @@ def response(
         shape = (x.shape[0], idx.size)
         a_all, b_all = np.broadcast_to(a, shape).ravel(), np.broadcast_to(b, shape).ravel()
 
-        def f(phi: FloatArray, quantity: object = quantity, shape: tuple[int, int] = shape) -> FloatArray:
+        def f(phi: FloatArray, quantity: Quantity = quantity, shape: tuple[int, int] = shape) -> FloatArray:
             made = made_motion(cam, phi.reshape(shape), deltas=deltas)
-            return np.asarray(quantity(made), dtype=float).ravel()  # type: ignore[operator]
+            got: FloatArray = np.asarray(quantity(made), dtype=float).ravel()
+            return got
 
         values = _golden(f, a_all, b_all).reshape(shape)
         peaks[key] = Quadratic.fit(x, values)
