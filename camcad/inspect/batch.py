@@ -18,7 +18,9 @@ refined by golden section between its grid neighbours on every stencil cam.
 The fit is not trusted: :func:`certify` re-solves exactly a sample of the
 study's own variants (the first ones drawn and those with the largest scaled
 errors, where the remainder is largest) and reports the largest difference of
-every figure; ``camcad tolerance`` writes it into ``tolerance.json``.
+every figure; ``camcad tolerance`` writes it into ``tolerance.json`` and
+refuses the study (:func:`untrusted`) where it exceeds :data:`TRUST` of the
+figure's spread over the made cams.
 
 :meth:`Response.figures` evaluates elementwise (no BLAS), in chunks of
 :data:`BATCH` variants, so its numbers do not depend on how the variants are
@@ -52,12 +54,26 @@ from camcad.inspect.tolerance import (
 if TYPE_CHECKING:
     from camcad.dynamics.spec import DynamicsSetup
 
-__all__ = ["BATCH", "CERTIFY", "Certificate", "Quadratic", "Response", "certify", "response", "stencil"]
+__all__ = [
+    "BATCH",
+    "CERTIFY",
+    "TRUST",
+    "Certificate",
+    "Quadratic",
+    "Response",
+    "certify",
+    "response",
+    "stencil",
+    "untrusted",
+]
 
 BATCH = 50_000
 """Variants evaluated at once by :meth:`Response.figures` (memory: a few tens of MB)."""
 CERTIFY = 200
 """Variants re-solved exactly by :func:`certify`: half the first drawn, half the largest scaled errors."""
+TRUST = 1e-3
+"""A figure's certified error must stay below this share of its spread (σ over the study's made cams)."""
+_FLOOR = 1e-9  # ... or below this share of its size (a figure the errors do not move)
 _KEEP = 0.5  # a grid peak of at least this share of the largest is a candidate
 _MAX_CANDIDATES = 8
 
@@ -274,3 +290,28 @@ def certify(
         pressure_angle=worst(exact[2], approx[2]),
         stress=worst(exact[3], approx[3]),
     )
+
+
+def untrusted(
+    cert: Certificate, figures: tuple[FloatArray, FloatArray, FloatArray, FloatArray], *, lift: float
+) -> tuple[str, ...]:
+    """The figures whose certified error exceeds :data:`TRUST` of their spread over ``figures``.
+
+    ``figures`` as :meth:`Response.figures` gives them for the study; ``lift``
+    the cam's lift [lift unit], the size of a dwell error that does not move.
+    The allowance is TRUST·σ + 1e-9·size (size: the lift for the dwell errors,
+    the largest value for a peak), so a figure no error moves is held to
+    round-off.
+    """
+    bad = []
+    names = ("dwell", "acceleration", "pressure_angle", "stress")
+    errors = (cert.dwell, cert.acceleration, cert.pressure_angle, cert.stress)
+    for name, err, values in zip(names, errors, figures, strict=True):
+        arr = np.asarray(values, dtype=float).reshape(len(values), -1)
+        if math.isnan(err) or arr.size == 0 or np.all(np.isnan(arr)):
+            continue
+        spread = float(np.nanmin(np.nanstd(arr, axis=0)))
+        size = lift if name == "dwell" else float(np.nanmax(np.abs(arr)))
+        if err > TRUST * spread + _FLOOR * size:
+            bad.append(name)
+    return tuple(bad)

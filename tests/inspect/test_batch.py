@@ -167,3 +167,21 @@ def test_the_design_as_a_made_cam_has_the_analysis_peak_stress(loaded):
     stress = variant_figures(cam, {Tol.FORM: np.zeros(1)}, setup=setup)[3][0]
     expected = analyse(design, fit=False, toolpath=False, strict=False).dynamics.hertz_stress_max.value
     assert stress == pytest.approx(expected, rel=1e-9)
+
+
+def test_a_certificate_beyond_the_trust_is_refused(loaded, fitted):
+    """The real certificate is trusted; one whose dwell or stress error is 0.2 % of the spread is not."""
+    import dataclasses
+
+    from camcad.inspect.batch import TRUST, untrusted
+
+    _, cam, setup = loaded
+    drawn = draw(TOLS, samples=300, seed=2)
+    figs = fitted.figures(drawn)
+    cert = certify(cam, fitted, drawn, setup=setup, count=8)
+    assert untrusted(cert, figs, lift=20.0) == ()
+    dwell_spread = float(np.min(np.std(figs[0], axis=0)))
+    worse = dataclasses.replace(
+        cert, dwell=2.0 * TRUST * dwell_spread, stress=2.0 * TRUST * float(np.std(figs[3]))
+    )
+    assert untrusted(worse, figs, lift=20.0) == ("dwell", "stress")
