@@ -300,8 +300,8 @@ def untrusted(
     ``figures`` as :meth:`Response.figures` gives them for the study; ``lift``
     the cam's lift [lift unit], the size of a dwell error that does not move.
     The allowance is TRUST·σ + 1e-9·size (size: the lift for the dwell errors,
-    the largest value for a peak), so a figure no error moves is held to
-    round-off.
+    the largest value for a peak but at least 1 in its unit), so a figure no
+    error moves is held to round-off.
     """
     bad = []
     names = ("dwell", "acceleration", "pressure_angle", "stress")
@@ -311,7 +311,7 @@ def untrusted(
         if math.isnan(err) or arr.size == 0 or np.all(np.isnan(arr)):
             continue
         spread = float(np.nanmin(np.nanstd(arr, axis=0)))
-        size = lift if name == "dwell" else float(np.nanmax(np.abs(arr)))
+        size = lift if name == "dwell" else max(float(np.nanmax(np.abs(arr))), 1.0)  # ≥ 1 unit: a 0° angle
         if err > TRUST * spread + _FLOOR * size:
             bad.append(name)
     return tuple(bad)
