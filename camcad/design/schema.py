@@ -350,6 +350,7 @@ _TOLERANCED: dict[str, Tol] = {
 }
 _StudyWord = enum.Enum("_StudyWord", [("MONTE_CARLO", "monte-carlo"), ("LINEAR", "linear")])
 _AllocationWord = enum.Enum("_AllocationWord", [("RSS", "rss"), ("WORST_CASE", "worst-case")])
+_EvaluationWord = enum.Enum("_EvaluationWord", [("EXACT", "exact"), ("QUADRATIC", "quadratic")])
 _TOLERANCE_RULES: dict[str, _Rule] = {
     **{
         f"{name}_{how}": _Rule(
@@ -367,6 +368,7 @@ _TOLERANCE_RULES: dict[str, _Rule] = {
     "dwell_accuracy": _Rule("float", check=_between(0.0, MAX_TOLERANCE_MM, " mm (° of swing)", lo_open=True)),
     "confidence": _Rule("float", check=_interval(0.0, 1.0, lo_open=True, hi_open=True)),
     "allocation": _Rule("enum", enum=_AllocationWord),  # camcad.inspect.tolerance.Method
+    "evaluation": _Rule("enum", enum=_EvaluationWord),  # camcad.inspect.spec.Evaluation
 }
 
 
@@ -1420,7 +1422,7 @@ def parse_tolerance(table: Any, design: Design) -> ToleranceSpec:
         Naming the key (``tolerance.form_pm``), the value and what is allowed.
     """
     from camcad.geometry.sensitivity import applicable, mount_of  # only a study needs these (SciPy)
-    from camcad.inspect.spec import StudyMethod, ToleranceSpec
+    from camcad.inspect.spec import Evaluation, StudyMethod, ToleranceSpec
     from camcad.inspect.tolerance import Distribution, Method, Tolerance
 
     kw = _section("tolerance", table)
@@ -1428,6 +1430,8 @@ def parse_tolerance(table: Any, design: Design) -> ToleranceSpec:
         kw["method"] = StudyMethod(kw["method"].value)
     if "allocation" in kw:
         kw["allocation"] = Method(kw["allocation"].value)
+    if "evaluation" in kw:
+        kw["evaluation"] = Evaluation(kw["evaluation"].value)
     allowed = applicable(mount_of(Cam.from_design(design)))
     tolerances: list[Tolerance] = []
     keys: list[str] = []
@@ -1470,7 +1474,7 @@ def parse_tolerance(table: Any, design: Design) -> ToleranceSpec:
         )
     extra = {
         k: kw[k]
-        for k in ("samples", "seed", "method", "dwell_accuracy", "confidence", "allocation")
+        for k in ("samples", "seed", "method", "dwell_accuracy", "confidence", "allocation", "evaluation")
         if k in kw
     }
     return ToleranceSpec(tolerances=tuple(tolerances), keys=tuple(keys), **extra)

@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
     from camcad.motion.program import Motion
 
-__all__ = ["analyse_dynamics"]
+__all__ = ["analyse_dynamics", "contact_stress_at"]
 
 _RAD_S_TO_RPM = 60.0 / (2.0 * math.pi)
 # the extremes analyse_dynamics reports, one per row of its quantity
@@ -213,6 +213,39 @@ def _model(setup: DynamicsSetup) -> _Model:
         )
 
     return evaluate
+
+
+def contact_stress_at(
+    motion: Motion,
+    *,
+    pressure_angle: ArrayLike,
+    profile_rho: ArrayLike,
+    setup: DynamicsSetup,
+    lever: ArrayLike | None = None,
+    roller_radius: ArrayLike | None = None,
+) -> FloatArray:
+    """The Hertz contact stress [MPa] of the design's dynamic model at the given samples alone.
+
+    What :func:`analyse_dynamics` computes at each sample (same model, same
+    load), without its extremes and findings: for a made cam whose motion,
+    pressure angle and profile radius differ from the design's (camcad's
+    tolerance study). ``roller_radius`` (n,) [mm] is each sample's own roller
+    (a made roller), None for the design's; the relative curvature is then
+    1/ρ + 1/r_f with that r_f (Johnson 1985, §4.3). A groove's flanks are not
+    supported (ValueError).
+    """
+    if setup.flank_offsets is not None:
+        raise ValueError("the contact stress of single samples is for a plate's one flank, not a groove")
+    rho = np.asarray(profile_rho, dtype=float)
+    if roller_radius is not None and setup.roller_radius:
+        # the model adds 1/r_f of the design: hand it the ρ with 1/ρ' = 1/ρ + 1/r_made − 1/r_f
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rho = 1.0 / (1.0 / rho + 1.0 / np.asarray(roller_radius, dtype=float) - 1.0 / setup.roller_radius)
+    n = np.asarray(motion.phi).size
+    alpha = _array("pressure_angle", pressure_angle, n)
+    lev = None if lever is None else _array("lever", lever, n)
+    out: FloatArray = np.asarray(_model(setup)(motion, alpha, _array("profile_rho", rho, n), lev).stress)
+    return out
 
 
 def analyse_dynamics(

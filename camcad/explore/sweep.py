@@ -18,7 +18,8 @@ then removed. The rows do not depend on the engine, the number of workers or
 the order chunks finish in: one serial run, a process pool and a Dask
 cluster give the same bytes.
 
-Engines: ``jobs == 1`` evaluates in this process; ``jobs > 1`` uses a
+Engines (:mod:`camcad.explore.cluster`, shared with ``camcad tolerance``):
+``jobs == 1`` evaluates in this process; ``jobs > 1`` uses a
 :class:`concurrent.futures.ProcessPoolExecutor` (the standard library's pool,
 started by ``forkserver``); ``scheduler="tcp://host:8786"`` sends the chunks
 to a running ``dask.distributed`` scheduler (the extra ``camcad[cluster]``;
@@ -29,23 +30,15 @@ from __future__ import annotations
 
 import contextlib
 import json
-import logging
 import math
-import os
-import re
 import shutil
-import signal
-import socket
-import sys
-import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from concurrent.futures.process import BrokenProcessPool
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from camcad.errors import CamcadError, OutputError, UsageError
+from camcad.explore.cluster import dask_map, process_map, scheduler_address, serial_map
 from camcad.explore.measures import Limit, Measure, analysis_row, failed_row
 from camcad.explore.pareto import pareto_mask
 from camcad.explore.plan import Chunk, SweepPlan
@@ -64,16 +57,9 @@ __all__ = [
 
 FORMATS = ("parquet", "csv")
 
-SCHEDULER_TIMEOUT_S = 10
-"""How long ``--scheduler`` waits for the scheduler's answer once its port accepts a connection [s]."""
-
-PROBE_TIMEOUT_S = 3.0
-"""How long ``--scheduler`` waits for the scheduler's port to accept a TCP connection [s]."""
-
-SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss")
-
-_ADDRESS = re.compile(
-    r"^(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+):(?P<port>[0-9]{1,5})/?$"
+_DIED = (
+    "a sweep worker process died (killed, or out of memory); the finished chunks are "
+    "kept: run the same command again to resume"
 )
 
 Progress = Callable[[int, int], None]
@@ -120,200 +106,6 @@ def evaluate_chunk(chunk: Chunk) -> list[dict[str, Any]]:
     ]
 
 
-def _serial(chunks: Sequence[Chunk]) -> Iterator[tuple[int, list[dict[str, Any]]]]:
-    for k, chunk in enumerate(chunks):
-        yield k, evaluate_chunk(chunk)
-
-
-PARENT_POLL_S = 0.2
-"""How often a local worker checks that the sweep that started it still runs [s]."""
-
-
-def _gone(pid: int) -> bool:
-    """Whether process ``pid`` has ended: no such process, or a zombie its own parent has not reaped yet."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as stat:
-            return stat.read().rpartition(b")")[2].split()[0] in (b"Z", b"X")
-    except FileNotFoundError:
-        return True
-    except OSError:  # no /proc here: ask the kernel whether it can be signalled
-        pass
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except OSError:  # another user's process: it exists
-        pass
-    return False
-
-
-def _die_with(parent: int) -> None:
-    """Run in each local worker as it starts: end it when the sweep process ``parent`` is gone.
-
-    A sweep killed outright (SIGKILL, out of memory) cannot stop its pool,
-    so each worker watches for itself: a daemon thread asks every
-    :data:`PARENT_POLL_S` whether ``parent`` still exists and ends the worker
-    at once when not (on Linux the kernel also ends it with its own parent,
-    the fork server, by ``PR_SET_PDEATHSIG``). The worker's stdout is the null
-    device, so no worker holds the caller's pipe open (``camcad sweep … | tee``).
-    """
-    import threading
-    import warnings
-
-    warnings.simplefilter("ignore")  # as in the command line: a library's warnings are not camcad's lines
-    with contextlib.suppress(OSError):
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, 1)
-        os.close(devnull)
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        with contextlib.suppress(OSError, AttributeError):
-            pr_set_pdeathsig = 1  # <linux/prctl.h>
-            ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
-
-    def watch() -> None:
-        while not _gone(parent):
-            time.sleep(PARENT_POLL_S)
-        os._exit(1)
-
-    threading.Thread(target=watch, name="camcad-parent-watch", daemon=True).start()
-
-
-def _processes(chunks: Sequence[Chunk], jobs: int) -> Iterator[tuple[int, list[dict[str, Any]]]]:
-    import multiprocessing
-
-    method = "forkserver" if sys.platform != "win32" else "spawn"
-    with ProcessPoolExecutor(
-        max_workers=jobs,
-        mp_context=multiprocessing.get_context(method),
-        initializer=_die_with,
-        initargs=(os.getpid(),),
-    ) as pool:
-        futures = {pool.submit(evaluate_chunk, chunk): k for k, chunk in enumerate(chunks)}
-        try:
-            for future in as_completed(futures):
-                try:
-                    rows = future.result()
-                except BrokenProcessPool as err:
-                    raise CamcadError(
-                        "a sweep worker process died (killed, or out of memory); the finished chunks are "
-                        "kept: run the same command again to resume"
-                    ) from err
-                yield futures[future], rows
-        finally:
-            for future in futures:
-                future.cancel()
-
-
-def scheduler_address(text: str) -> tuple[str, int]:
-    """The host and port of a ``--scheduler`` address ``[scheme://]host:port`` (scheme tcp, tls, ws, wss).
-
-    Raises
-    ------
-    UsageError
-        Naming ``--scheduler`` when the text is not such an address.
-    """
-    match = _ADDRESS.match(text.strip())
-    scheme = (match["scheme"] or "tcp").lower() if match else ""
-    if match is None or scheme not in SCHEDULER_SCHEMES or not 1 <= int(match["port"]) <= 65535:
-        raise UsageError(
-            "--scheduler",
-            f"{text!r} is not a scheduler address (allowed: SCHEME://HOST:PORT with SCHEME "
-            f"{', '.join(SCHEDULER_SCHEMES)} and PORT 1 to 65535, e.g. tcp://host:8786)",
-        )
-    return match["host"].strip("[]"), int(match["port"])
-
-
-def _probe(scheduler: str) -> None:
-    """Raise UsageError naming ``--scheduler`` unless its port accepts a connection within seconds.
-
-    A refused or unreachable port is found here at once (Dask's own client
-    would retry it until its timeout, then need as long again to close).
-    """
-    host, port = scheduler_address(scheduler)
-    try:
-        with socket.create_connection((host, port), timeout=PROBE_TIMEOUT_S):
-            pass
-    except OSError as err:
-        why = (
-            f"no answer within {PROBE_TIMEOUT_S:g} s"
-            if isinstance(err, TimeoutError)
-            else err.strerror or err
-        )
-        raise UsageError("--scheduler", f"cannot reach the Dask scheduler {scheduler!r}: {why}") from None
-
-
-@contextlib.contextmanager
-def _quiet_distributed() -> Iterator[None]:
-    """Keep dask.distributed's own log lines (its handlers write to stderr) off the terminal."""
-    logger = logging.getLogger("distributed")
-    disabled = logger.disabled
-    logger.disabled = True
-    try:
-        yield
-    finally:
-        logger.disabled = disabled
-
-
-def _connect(scheduler: str) -> Any:
-    """A ``distributed.Client`` of the scheduler, or UsageError naming ``--scheduler`` within seconds.
-
-    A client that failed to connect is closed here, with a short timeout, so
-    that its finaliser does not wait 2 × the timeout later and print a
-    traceback when the process ends.
-    """
-    from distributed import Client
-
-    made: list[Any] = []
-
-    class _Client(Client):  # type: ignore[misc]
-        def __init__(self, *args: Any, **kwargs: Any) -> None:
-            made.append(self)
-            super().__init__(*args, **kwargs)
-
-    _probe(scheduler)
-    try:
-        return _Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=False)
-    except Exception as err:  # refused, timed out, or something that is not a scheduler answered
-        for client in made:
-            with contextlib.suppress(Exception):  # whatever the half-made client raises on closing
-                client.close(timeout=1)
-            client.status = "closed"  # its finaliser has nothing left to do
-        why = (
-            f"{err}"
-            if isinstance(err, (OSError, TimeoutError, ValueError))
-            else "no Dask scheduler answers there"
-        )
-        raise UsageError("--scheduler", f"cannot reach the Dask scheduler {scheduler!r}: {why}") from None
-
-
-def _dask(chunks: Sequence[Chunk], scheduler: str) -> Iterator[tuple[int, list[dict[str, Any]]]]:
-    try:
-        from distributed import as_completed as dask_completed
-    except ImportError:
-        raise UsageError("--scheduler", "needs dask.distributed: pip install 'camcad[cluster]'") from None
-    with _quiet_distributed():
-        yield from _on_cluster(chunks, scheduler, dask_completed)
-
-
-def _on_cluster(
-    chunks: Sequence[Chunk], scheduler: str, dask_completed: Any
-) -> Iterator[tuple[int, list[dict[str, Any]]]]:
-    client = _connect(scheduler)
-    try:
-        futures = client.map(evaluate_chunk, list(chunks), pure=False)
-        index = {future.key: k for k, future in enumerate(futures)}
-        try:
-            with client.as_current():
-                for future, rows in dask_completed(futures, with_results=True):
-                    yield index[future.key], rows
-        finally:
-            client.cancel(futures)
-    finally:
-        client.close()
-
-
 def run_sweep(
     plan: SweepPlan,
     *,
@@ -346,11 +138,11 @@ def run_sweep(
     if todo:
         work = [chunks[k] for k in todo]
         if scheduler is not None:
-            results = _dask(work, scheduler)
+            results = dask_map(evaluate_chunk, work, scheduler)
         elif jobs == 1 or len(work) == 1:
-            results = _serial(work)
+            results = serial_map(evaluate_chunk, work)
         else:
-            results = _processes(work, min(jobs, len(work)))
+            results = process_map(evaluate_chunk, work, min(jobs, len(work)), died=_DIED)
         for j, rows in results:
             finished[todo[j]] = rows
             if on_chunk is not None:

@@ -5,9 +5,9 @@ cam are drawn at once in this process (same seed, same variants), cut into
 chunks of :data:`CHUNK` variants in a fixed order, and each chunk is
 re-solved together (:func:`~camcad.inspect.tolerance.variant_figures`) in
 this process, in local worker processes or on a Dask cluster, using the
-sweep's engines (:mod:`camcad.explore.sweep`: the forkserver pool whose
-workers end with the command, the scheduler address and the cluster
-client). A chunk's figures depend only on its variants, so every engine and
+engines it shares with the sweep (:mod:`camcad.explore.cluster`: the
+forkserver pool whose workers end with the command, the scheduler address
+and the cluster client). A chunk's figures depend only on its variants, so every engine and
 any number of workers give the same rows, byte for byte.
 
 Files, written all or nothing (:func:`camcad.export.atomic.staged_folder`):
@@ -27,22 +27,23 @@ import base64
 import html
 import json
 import math
-import os
-import sys
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from concurrent.futures.process import BrokenProcessPool
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from camcad._typing import FloatArray
-from camcad.errors import CamcadError, UsageError
+from camcad.errors import DesignError, UsageError
+from camcad.explore.cluster import dask_map, process_map, scheduler_address, serial_map
 from camcad.geometry.cam import Cam
 from camcad.geometry.sensitivity import Tol
-from camcad.inspect.spec import StudyMethod, ToleranceSpec
+
+if TYPE_CHECKING:
+    from camcad.dynamics.spec import DynamicsSetup
+from camcad.inspect.batch import BATCH, TRUST, certify, response, untrusted
+from camcad.inspect.spec import Evaluation, StudyMethod, ToleranceSpec
 from camcad.inspect.tolerance import (
     PERCENTILES,
     Distribution,
@@ -50,6 +51,7 @@ from camcad.inspect.tolerance import (
     Method,
     allocate,
     draw,
+    dwell_angles,
     linear_dwell,
     variant_figures,
 )
@@ -88,125 +90,182 @@ def _column(key: str) -> str:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ToleranceChunk:
-    """One unit of work: the cam, the first variant's index, and the chunk's drawn errors (mm; PHASE rad)."""
+    """One unit of work: the cam, its dynamics, and the chunk's drawn errors (mm; PHASE rad)."""
 
     cam: Cam
     start: int
     deltas: tuple[tuple[Tol, FloatArray], ...]
-    columns: tuple[str, ...]
+    setup: DynamicsSetup | None = None
 
 
-def evaluate_tolerance_chunk(chunk: ToleranceChunk) -> list[dict[str, Any]]:
-    """The rows of one chunk (what a worker runs)."""
-    deltas = dict(chunk.deltas)
-    dwell_err, acc, alpha = variant_figures(chunk.cam, deltas, step=STEP)
-    unit = _unit(chunk.cam)
-    rows = []
-    for i in range(dwell_err.shape[0]):
-        row: dict[str, Any] = {"index": chunk.start + i}
-        for (tol, values), column in zip(chunk.deltas, chunk.columns, strict=True):
-            row[column] = math.degrees(float(values[i])) if tol is Tol.PHASE else float(values[i])
-        for k in range(dwell_err.shape[1]):
-            row[f"dwell_error_{k}_{unit}"] = float(dwell_err[i, k])
-        row[f"peak_acceleration_{unit}_per_rad2"] = None if math.isnan(acc[i]) else float(acc[i])
-        row["peak_pressure_angle_deg"] = math.degrees(float(alpha[i]))
-        rows.append(row)
-    return rows
+Figures = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
+"""Dwell errors (V, D), peak |a| (V,), peak |α| [rad] (V,), peak contact stress [MPa] (V,)."""
 
 
-def _chunks(cam: Cam, spec: ToleranceSpec) -> list[ToleranceChunk]:
-    drawn = draw(spec.tolerances, samples=spec.samples, seed=spec.seed)
-    columns = tuple(_column(k) for k in spec.keys)
+def evaluate_tolerance_chunk(chunk: ToleranceChunk) -> Figures:
+    """The figures of one chunk's made cams, each re-solved (what a worker runs)."""
+    return variant_figures(chunk.cam, dict(chunk.deltas), step=STEP, setup=chunk.setup)
+
+
+def _chunks(
+    cam: Cam, spec: ToleranceSpec, drawn: Mapping[Tol, FloatArray], setup: DynamicsSetup | None
+) -> list[ToleranceChunk]:
     return [
         ToleranceChunk(
             cam=cam,
             start=lo,
             deltas=tuple((t.tol, np.array(drawn[t.tol][lo : lo + CHUNK])) for t in spec.tolerances),
-            columns=columns,
+            setup=setup,
         )
         for lo in range(0, spec.samples, CHUNK)
     ]
 
 
-# -- engines (the sweep's: its worker lifetime and its cluster client) ---------------------------
-
-
-def _serial(chunks: Sequence[ToleranceChunk]) -> Iterator[tuple[int, list[dict[str, Any]]]]:
-    for k, chunk in enumerate(chunks):
-        yield k, evaluate_tolerance_chunk(chunk)
-
-
-def _processes(chunks: Sequence[ToleranceChunk], jobs: int) -> Iterator[tuple[int, list[dict[str, Any]]]]:
-    import multiprocessing
-
-    from camcad.explore.sweep import _die_with
-
-    method = "forkserver" if sys.platform != "win32" else "spawn"
-    with ProcessPoolExecutor(
-        max_workers=jobs,
-        mp_context=multiprocessing.get_context(method),
-        initializer=_die_with,
-        initargs=(os.getpid(),),
-    ) as pool:
-        futures = {pool.submit(evaluate_tolerance_chunk, chunk): k for k, chunk in enumerate(chunks)}
-        try:
-            for future in as_completed(futures):
-                try:
-                    rows = future.result()
-                except BrokenProcessPool as err:
-                    raise CamcadError("a tolerance worker process died (killed, or out of memory)") from err
-                yield futures[future], rows
-        finally:
-            for future in futures:
-                future.cancel()
-
-
-def _dask(chunks: Sequence[ToleranceChunk], scheduler: str) -> Iterator[tuple[int, list[dict[str, Any]]]]:
-    try:
-        from distributed import as_completed as dask_completed
-    except ImportError:
-        raise UsageError("--scheduler", "needs dask.distributed: pip install 'camcad[cluster]'") from None
-    from camcad.explore.sweep import _connect, _quiet_distributed
-
-    with _quiet_distributed():
-        client = _connect(scheduler)
-        try:
-            futures = client.map(evaluate_tolerance_chunk, list(chunks), pure=False)
-            index = {future.key: k for k, future in enumerate(futures)}
-            try:
-                with client.as_current():
-                    for future, rows in dask_completed(futures, with_results=True):
-                        yield index[future.key], rows
-            finally:
-                client.cancel(futures)
-        finally:
-            client.close()
+def _exact(
+    cam: Cam,
+    spec: ToleranceSpec,
+    drawn: Mapping[Tol, FloatArray],
+    setup: DynamicsSetup | None,
+    *,
+    jobs: int,
+    scheduler: str | None,
+    progress: Progress | None,
+) -> Figures:
+    chunks = _chunks(cam, spec, drawn, setup)
+    if scheduler is not None:
+        results = dask_map(evaluate_tolerance_chunk, chunks, scheduler)
+    elif jobs == 1 or len(chunks) == 1:
+        results = serial_map(evaluate_tolerance_chunk, chunks)
+    else:
+        results = process_map(
+            evaluate_tolerance_chunk,
+            chunks,
+            min(jobs, len(chunks)),
+            died="a tolerance worker process died (killed, or out of memory)",
+        )
+    done: dict[int, Figures] = {}
+    for k, figures in results:
+        done[k] = figures
+        if progress is not None:
+            progress(len(done), len(chunks))
+    parts = [done[k] for k in range(len(chunks))]
+    d = len(dwell_angles(cam))
+    return (
+        np.vstack([p[0] for p in parts]) if parts else np.zeros((0, d)),
+        *(np.concatenate([p[i] for p in parts]) for i in (1, 2, 3)),
+    )  # type: ignore[return-value]
 
 
 def run_variants(
     cam: Cam,
     spec: ToleranceSpec,
     *,
+    setup: DynamicsSetup | None = None,
     jobs: int = 1,
     scheduler: str | None = None,
     progress: Progress | None = None,
-) -> list[dict[str, Any]]:
-    """Every made cam's row, in variant order, on the engine chosen (see the module notes)."""
+    batch: int = BATCH,
+) -> tuple[dict[str, FloatArray], dict[str, Any]]:
+    """Every made cam's figures as table columns in variant order, and how they were evaluated.
+
+    ``spec.evaluation`` EXACT: each made cam re-solved on the engine chosen
+    (see the module notes); QUADRATIC: the certified quadratics
+    (:mod:`camcad.inspect.batch`) in this process, ``batch`` variants at a
+    time (the engines are not needed: 10⁶ variants take seconds).
+    """
     if jobs < 1:
         raise UsageError("--jobs", f"{jobs} is not allowed (allowed: 1 or more worker processes)")
-    chunks = _chunks(cam, spec)
-    if scheduler is not None:
-        results = _dask(chunks, scheduler)
-    elif jobs == 1 or len(chunks) == 1:
-        results = _serial(chunks)
-    else:
-        results = _processes(chunks, min(jobs, len(chunks)))
-    done: dict[int, list[dict[str, Any]]] = {}
-    for k, rows in results:
-        done[k] = rows
+    drawn = draw(spec.tolerances, samples=spec.samples, seed=spec.seed)
+    how: dict[str, Any] = {"method": spec.evaluation.value}
+    if spec.evaluation is Evaluation.QUADRATIC:
+        fitted = response(cam, spec.tolerances, setup=setup, step=STEP)
+        figures = fitted.figures(drawn, batch=batch)
+        cert = certify(cam, fitted, drawn, setup=setup, step=STEP)
+        bad = untrusted(cert, figures, lift=float(np.max(np.abs(cam.motion(cam.sample_phi(STEP)).s))))
+        if bad:
+            raise DesignError(
+                "tolerance.evaluation",
+                f'"quadratic" does not hold for these tolerances ({", ".join(bad)}: the made cams '
+                f're-solved exactly differ by more than {TRUST:g} of the spread); allowed: "exact"',
+            )
         if progress is not None:
-            progress(len(done), len(chunks))
-    return [row for k in range(len(chunks)) for row in done[k]]
+            progress(1, 1)
+        how |= {
+            "stencil_variants": fitted.stencil_variants,
+            "certified_variants": len(cert.indices),
+            "max_abs_difference_from_exact": {
+                f"dwell_error_{_unit(cam)}": _finite(cert.dwell),
+                f"peak_acceleration_{_unit(cam)}_per_rad2": _finite(cert.acceleration),
+                "peak_pressure_angle_deg": _finite(math.degrees(cert.pressure_angle)),
+                "peak_contact_stress_mpa": _finite(cert.stress),
+            },
+        }
+    else:
+        figures = _exact(cam, spec, drawn, setup, jobs=jobs, scheduler=scheduler, progress=progress)
+    return _columns(cam, spec, drawn, figures), how
+
+
+def _finite(value: float) -> float | None:
+    return None if math.isnan(value) else value
+
+
+def _columns(
+    cam: Cam, spec: ToleranceSpec, drawn: Mapping[Tol, FloatArray], figures: Figures
+) -> dict[str, FloatArray]:
+    """The table: ``index``, the drawn errors (phase in degrees), the dwell errors and the peaks."""
+    unit = _unit(cam)
+    dwell_err, acc, alpha, stress = figures
+    out: dict[str, FloatArray] = {"index": np.arange(spec.samples, dtype=np.int64)}
+    for key, t in zip(spec.keys, spec.tolerances, strict=True):
+        values = np.asarray(drawn[t.tol], dtype=float)
+        out[_column(key)] = np.degrees(values) if t.tol is Tol.PHASE else values
+    for k in range(dwell_err.shape[1]):
+        out[f"dwell_error_{k}_{unit}"] = np.ascontiguousarray(dwell_err[:, k])
+    out[f"peak_acceleration_{unit}_per_rad2"] = acc
+    out["peak_pressure_angle_deg"] = np.degrees(alpha)
+    out["peak_contact_stress_mpa"] = stress
+    return out
+
+
+CSV_ROWS = 20_000
+"""Rows formatted at once when the CSV is written (its memory does not grow with the study)."""
+
+
+def _csv_lines(columns: Mapping[str, FloatArray]) -> Iterator[str]:
+    """The table as CSV text pieces: floats by ``repr`` (read back bit for bit), NaN as an empty cell."""
+    names = list(columns)
+    yield ",".join(names) + "\n"
+    count = len(next(iter(columns.values()))) if names else 0
+    for lo in range(0, count, CSV_ROWS):
+        cells = []
+        for name in names:
+            values = columns[name][lo : lo + CSV_ROWS]
+            if values.dtype.kind == "i":
+                cells.append([str(v) for v in values.tolist()])
+            else:
+                cells.append(["" if v != v else repr(v) for v in values.tolist()])
+        yield "".join(",".join(row) + "\n" for row in zip(*cells, strict=True))
+
+
+def _write_csv(path: Path, columns: Mapping[str, FloatArray]) -> None:
+    with path.open("w", encoding="utf-8", newline="") as out:
+        out.writelines(_csv_lines(columns))
+
+
+def _parquet(columns: Mapping[str, FloatArray]) -> bytes:
+    """The table as Parquet (zstd), NaN as null."""
+    import io
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    arrays = {
+        name: pa.array(v) if v.dtype.kind == "i" else pa.array(v, mask=np.isnan(v))
+        for name, v in columns.items()
+    }
+    buf = io.BytesIO()
+    pq.write_table(pa.table(arrays), buf, compression="zstd")
+    return buf.getvalue()
 
 
 # -- the linear figures, the bands, the summary ---------------------------------------------------
@@ -251,21 +310,18 @@ def linear_bands(cam: Cam, spec: ToleranceSpec, phi: FloatArray) -> Bands:
     return Bands(phi=phi, nominal=nominal, rss=rss, worst=worst)
 
 
-def _band_rows(bands: Bands, unit: str) -> list[dict[str, Any]]:
+def _band_columns(bands: Bands, unit: str) -> dict[str, FloatArray]:
     names = {
         "lift": f"lift_{unit}",
         "velocity": f"velocity_{unit}_per_rad",
         "pressure_angle": "pressure_angle_deg",
     }
-    rows = []
-    for i, phi in enumerate(bands.phi):
-        row: dict[str, Any] = {"angle_deg": math.degrees(float(phi))}
-        for key, name in names.items():
-            row[name] = float(bands.nominal[key][i])
-            row[f"{name}_rss3sigma"] = float(bands.rss[key][i])
-            row[f"{name}_worst_case"] = float(bands.worst[key][i])
-        rows.append(row)
-    return rows
+    out: dict[str, FloatArray] = {"angle_deg": np.degrees(bands.phi)}
+    for key, name in names.items():
+        out[name] = np.asarray(bands.nominal[key], dtype=float)
+        out[f"{name}_rss3sigma"] = np.asarray(bands.rss[key], dtype=float)
+        out[f"{name}_worst_case"] = np.asarray(bands.worst[key], dtype=float)
+    return out
 
 
 def _pct(values: FloatArray) -> list[float] | None:
@@ -312,19 +368,26 @@ def _allocation(spec: ToleranceSpec, lin: LinearDwell, unit: str) -> dict[str, A
     }
 
 
-def _nominal_peaks(cam: Cam) -> tuple[float, float]:
-    """Peak |a| [lift unit/rad²] and |α| [rad] of the design, found as for a made cam with no error."""
-    _, acc, alpha = variant_figures(cam, {Tol.FORM: np.zeros(1)}, step=STEP)
-    return float(acc[0]), float(alpha[0])
+def _nominal_peaks(cam: Cam, setup: DynamicsSetup | None) -> tuple[float, float, float]:
+    """Peak |a| [lift unit/rad²], |α| [rad] and contact stress [MPa] of the design, as for a made cam."""
+    _, acc, alpha, stress = variant_figures(cam, {Tol.FORM: np.zeros(1)}, step=STEP, setup=setup)
+    return float(acc[0]), float(alpha[0]), float(stress[0])
 
 
 def tolerance_summary(
-    cam: Cam, spec: ToleranceSpec, rows: Sequence[Mapping[str, Any]] | None, *, name: str, source: str
+    cam: Cam,
+    spec: ToleranceSpec,
+    columns: Mapping[str, FloatArray] | None,
+    *,
+    name: str,
+    source: str,
+    setup: DynamicsSetup | None = None,
+    evaluation: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """The figures of ``tolerance.json`` (rows: the Monte-Carlo table, or None for the linear method)."""
+    """The figures of ``tolerance.json`` (columns: the Monte-Carlo table, or None for the linear method)."""
     unit = _unit(cam)
     lin = linear_dwell(cam, spec.tolerances)
-    acc0, alpha0 = _nominal_peaks(cam)
+    acc0, alpha0, stress0 = _nominal_peaks(cam, setup)
     dwells = []
     for k, phi in enumerate(lin.dwell_phi):
         entry: dict[str, Any] = {
@@ -338,8 +401,8 @@ def tolerance_summary(
                 },
             },
         }
-        if rows is not None:
-            values = np.array([r[f"dwell_error_{k}_{unit}"] for r in rows], dtype=float)
+        if columns is not None:
+            values = np.asarray(columns[f"dwell_error_{k}_{unit}"], dtype=float)
             entry["monte_carlo"] = {
                 "mean": float(np.mean(values)),
                 "std": float(np.std(values, ddof=1)),
@@ -364,20 +427,21 @@ def tolerance_summary(
         "percentiles_at": list(PERCENTILES),
         "dwells": dwells,
     }
-    acc_key = f"peak_acceleration_{unit}_per_rad2"
-    out["peak_acceleration"] = {"unit": f"{unit}/rad^2", "nominal": None if math.isnan(acc0) else acc0}
+    out["peak_acceleration"] = {"unit": f"{unit}/rad^2", "nominal": _finite(acc0)}
     out["peak_pressure_angle"] = {"unit": "deg", "nominal": math.degrees(alpha0)}
-    if rows is not None:
+    out["contact_stress"] = {"unit": "MPa", "nominal": _finite(stress0)}
+    if columns is not None:
         out["samples"], out["seed"] = spec.samples, spec.seed
-        acc = np.array([math.nan if r[acc_key] is None else r[acc_key] for r in rows], dtype=float)
-        out["peak_acceleration"]["percentiles"] = _pct(acc)
-        alpha = np.array([r["peak_pressure_angle_deg"] for r in rows], dtype=float)
-        out["peak_pressure_angle"]["percentiles"] = _pct(alpha)
-    out["contact_stress"] = None
-    out["contact_stress_note"] = (
-        "not computed: a made cam's contact force needs the dynamics re-run per variant, which the batch "
-        "re-solve of the motion does not do"
-    )
+        out["evaluation"] = dict(evaluation or {"method": spec.evaluation.value})
+        out["peak_acceleration"]["percentiles"] = _pct(columns[f"peak_acceleration_{unit}_per_rad2"])
+        out["peak_pressure_angle"]["percentiles"] = _pct(columns["peak_pressure_angle_deg"])
+        out["contact_stress"]["percentiles"] = _pct(columns["peak_contact_stress_mpa"])
+    if math.isnan(stress0):
+        out["contact_stress_note"] = (
+            "not computed: no dynamics setup given"
+            if setup is None
+            else "not computed: a groove's flanks, or a face on an arm (its made acceleration is not found)"
+        )
     out["allocation"] = _allocation(spec, lin, unit)
     return out
 
@@ -434,6 +498,40 @@ def _band_figure(bands: Bands, key: str, label: str, envelope: tuple[FloatArray,
     return base64.b64encode(svg(fig)).decode("ascii")
 
 
+def _peaks_table(summary: Mapping[str, Any], unit: str, pct_head: str) -> list[str]:
+    """The peaks' section: each figure's design value and its Monte-Carlo percentiles."""
+    rows = []
+    for key, label in (
+        ("peak_acceleration", f"peak |acceleration| [{unit}/rad²]"),
+        ("peak_pressure_angle", "peak |pressure angle| [°]"),
+        ("contact_stress", "peak contact stress [MPa]"),
+    ):
+        fig = summary.get(key) or {}
+        nominal = fig.get("nominal")
+        cells = "".join(f'<td class="n">{v:.5g}</td>' for v in (fig.get("percentiles") or []) if pct_head)
+        shown = "—" if nominal is None else f"{nominal:.5g}"
+        rows.append(f'<tr><td>{_e(label)}</td><td class="n">{shown}</td>{cells}</tr>')
+    out = [
+        "<h2>Peaks of the made cams</h2>",
+        f"<table><tr><th>figure</th><th>design</th>{pct_head}</tr>" + "".join(rows) + "</table>",
+    ]
+    note = summary.get("contact_stress_note")
+    if note:
+        out.append(f"<p>Contact stress {_e(note)}.</p>")
+    how = summary.get("evaluation") or {}
+    if how.get("method") == "quadratic":
+        worst = "; ".join(
+            f"{_e(k)} {'—' if v is None else f'{v:.2g}'}"
+            for k, v in how["max_abs_difference_from_exact"].items()
+        )
+        out.append(
+            f"<p>Evaluated by quadratics fitted on {how['stencil_variants']} re-solved made cams; on "
+            f"{how['certified_variants']} of these made cams re-solved exactly the largest differences were: "
+            f"{worst}.</p>"
+        )
+    return out
+
+
 def tolerance_page(cam: Cam, spec: ToleranceSpec, summary: Mapping[str, Any], *, table: str) -> str:
     """The HTML text of ``tolerance.html``."""
     unit = summary["lift_unit"]
@@ -468,6 +566,7 @@ def tolerance_page(cam: Cam, spec: ToleranceSpec, summary: Mapping[str, Any], *,
         + "".join(dwell_rows)
         + "</table>",
     ]
+    body += _peaks_table(summary, unit, pct_head if env else "")
     alloc = summary.get("allocation")
     if alloc is not None:
         items = "".join(
@@ -509,11 +608,21 @@ def tolerance_page(cam: Cam, spec: ToleranceSpec, summary: Mapping[str, Any], *,
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ToleranceResult:
-    """The files written, the table's rows and the summary of ``tolerance.json``."""
+    """The files written, the table's columns and the summary of ``tolerance.json``."""
 
     files: tuple[Path, ...]
-    rows: tuple[dict[str, Any], ...]
+    columns: Mapping[str, FloatArray]
     summary: dict[str, Any]
+
+    @property
+    def rows(self) -> list[dict[str, Any]]:
+        """The table as one mapping per row (NaN as None): for small studies."""
+        names = list(self.columns)
+        lists = [self.columns[n].tolist() for n in names]
+        return [
+            {n: (None if isinstance(v, float) and v != v else v) for n, v in zip(names, row, strict=True)}
+            for row in zip(*lists, strict=True)
+        ]
 
 
 def tolerance_study(
@@ -527,6 +636,7 @@ def tolerance_study(
     jobs: int = 1,
     scheduler: str | None = None,
     progress: Progress | None = None,
+    setup: DynamicsSetup | None = None,
 ) -> ToleranceResult:
     """Run the study and write ``tolerance.{parquet,csv}``, ``tolerance.json`` and ``tolerance.html``.
 
@@ -538,9 +648,7 @@ def tolerance_study(
     OutputError
         When ``outdir`` cannot be written.
     """
-    from camcad.explore.sweep import scheduler_address
-    from camcad.explore.table import csv_text, parquet_bytes
-    from camcad.export.atomic import atomic_write_bytes, atomic_write_text, staged_folder
+    from camcad.export.atomic import atomic_write, atomic_write_bytes, atomic_write_text, staged_folder
 
     if fmt not in FORMATS:
         raise UsageError("--format", f"{fmt!r} is not allowed (allowed: {', '.join(FORMATS)})")
@@ -557,21 +665,21 @@ def tolerance_study(
         raise UsageError("--jobs", f"{jobs} is not allowed (allowed: 1 or more worker processes)")
     linear_dwell(cam, spec.tolerances)  # refused before any work: a tolerance that does not apply
     if spec.method is StudyMethod.MONTE_CARLO:
-        rows = run_variants(cam, spec, jobs=jobs, scheduler=scheduler, progress=progress)
-        summary = tolerance_summary(cam, spec, rows, name=name, source=source)
+        columns, how = run_variants(cam, spec, setup=setup, jobs=jobs, scheduler=scheduler, progress=progress)
+        summary = tolerance_summary(cam, spec, columns, name=name, source=source, setup=setup, evaluation=how)
     else:
-        rows = _band_rows(linear_bands(cam, spec, cam.sample_phi(STEP)), _unit(cam))
-        summary = tolerance_summary(cam, spec, None, name=name, source=source)
+        columns = _band_columns(linear_bands(cam, spec, cam.sample_phi(STEP)), _unit(cam))
+        summary = tolerance_summary(cam, spec, None, name=name, source=source, setup=setup)
     table = f"tolerance.{fmt}"
     page = tolerance_page(cam, spec, summary, table=table)
     text = json.dumps(summary, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
     outdir = Path(outdir)
     with staged_folder(outdir) as staging:
         if fmt == "parquet":
-            atomic_write_bytes(staging.path / table, parquet_bytes(rows))
+            atomic_write_bytes(staging.path / table, _parquet(columns))
         else:
-            atomic_write_text(staging.path / table, csv_text(rows))
+            atomic_write(staging.path / table, lambda path: _write_csv(path, columns))
         atomic_write_text(staging.path / "tolerance.json", text)
         atomic_write_text(staging.path / "tolerance.html", page)
     names = (table, "tolerance.json", "tolerance.html")
-    return ToleranceResult(files=tuple(outdir / n for n in names), rows=tuple(rows), summary=summary)
+    return ToleranceResult(files=tuple(outdir / n for n in names), columns=columns, summary=summary)

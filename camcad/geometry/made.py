@@ -57,6 +57,11 @@ class MadeMotion:
     ``lift`` in the program's unit (mm or ° of swing), ``velocity`` per rad,
     ``acceleration`` per rad² (NaN for a face on an arm), ``pressure_angle``
     [rad], ``contact`` the cam-frame parameter u of the contact on the design [rad].
+    For the contact stress: ``profile_rho`` the made cam profile's signed radius
+    of curvature at the contact [mm] (convex > 0, ``inf`` straight),
+    ``roller_radius`` the made roller's radius [mm] (0 for a face) and
+    ``lever`` the distance from an arm's pivot to the driven point (the roller
+    centre, a face's contact) [mm], NaN on a slide.
     """
 
     phi: FloatArray
@@ -65,6 +70,9 @@ class MadeMotion:
     acceleration: FloatArray
     pressure_angle: FloatArray
     contact: FloatArray
+    profile_rho: FloatArray
+    roller_radius: FloatArray
+    lever: FloatArray
 
 
 def _j(v: FloatArray) -> FloatArray:
@@ -189,12 +197,14 @@ def made_motion(
     sigma = mount0.sigma
     angle = sigma * (phi_all - phase)  # the cam's turn: R(σ(φ − δ))
     u = phi_all - phase
-    for _ in range(_ITERATIONS):
+    done = np.zeros(u.shape, dtype=bool)
+    for _ in range(_ITERATIONS):  # each point stops on its own: a batch gives each variant's own bytes
         curve = made_curve(cam, u, w, form)
         g, g_u = _condition(mount0, mounts, curve, angle)
         step = np.clip(g / g_u, -_MAX_STEP, _MAX_STEP)
-        u = u - step
-        if np.all(np.abs(step) < 1e-13):
+        u = np.where(done, u, u - step)
+        done |= np.abs(step) < 1e-13
+        if np.all(done):
             break
     curve = made_curve(cam, u, w, form)
     g, g_u = _condition(mount0, mounts, curve, angle)
@@ -207,6 +217,17 @@ def made_motion(
         )
     lift, vel, acc, alpha = _kinematics(mount0, mounts, curve, angle, g_u)
     scale = mount0.lift_scale
+    roller = mount0.roller_radius + (per_point(Tol.ROLLER_RADIUS) if mount0.has_circle else 0.0)
+    # the made profile is the made base curve offset inwards by the made roller: ρ = ρ_base − r_f
+    # (an offset curve's radius, Rothbart 2004, §6), as 1/ρ = κ/(1 − r_f·κ) so a straight flank stays finite
+    kappa = curve.curvature
+    with np.errstate(divide="ignore", invalid="ignore"):
+        profile_rho = 1.0 / (kappa / (1.0 - roller * kappa))
+    if mount0.axis is None:
+        arm = _turn(curve.x, angle) - mounts.pivot  # to the roller centre, or to a face's contact
+        lever = np.hypot(arm[:, 0], arm[:, 1])
+    else:
+        lever = np.full(u.shape, np.nan)
     out_shape = (*shape, count)
     out = MadeMotion(
         phi=ph,
@@ -215,8 +236,12 @@ def made_motion(
         acceleration=(acc * scale).reshape(out_shape),
         pressure_angle=alpha.reshape(out_shape),
         contact=u.reshape(out_shape),
+        profile_rho=np.asarray(profile_rho, dtype=float).reshape(out_shape),
+        roller_radius=np.broadcast_to(np.asarray(roller, dtype=float), u.shape).reshape(out_shape).copy(),
+        lever=lever.reshape(out_shape),
     )
     readonly(out.phi, out.lift, out.velocity, out.acceleration, out.pressure_angle, out.contact)
+    readonly(out.profile_rho, out.roller_radius, out.lever)
     return out
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from camcad.inspect.tolerance import Method, Tolerance
 
-__all__ = ["StudyMethod", "ToleranceSpec"]
+__all__ = ["Evaluation", "StudyMethod", "ToleranceSpec"]
 
 
 class StudyMethod(enum.Enum):
@@ -19,6 +19,18 @@ class StudyMethod(enum.Enum):
 
     MONTE_CARLO = "monte-carlo"
     LINEAR = "linear"
+
+
+class Evaluation(enum.Enum):
+    """How the Monte-Carlo made cams are evaluated: each re-solved, or by the certified quadratics.
+
+    ``EXACT``: every made cam re-solved (:func:`camcad.inspect.tolerance.variant_figures`);
+    ``QUADRATIC``: every figure as a quadratic in the errors fitted on a stencil of
+    re-solved cams and certified on a sample (:mod:`camcad.inspect.batch`), for 10⁵–10⁶ variants.
+    """
+
+    EXACT = "exact"
+    QUADRATIC = "quadratic"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -42,6 +54,8 @@ class ToleranceSpec:
         Fraction of parts within ±E for an RSS allocation, in (0, 1).
     allocation
         ``RSS`` or ``WORST_CASE``.
+    evaluation
+        ``EXACT`` or ``QUADRATIC`` (Monte Carlo only).
     """
 
     tolerances: tuple[Tolerance, ...]
@@ -52,3 +66,4 @@ class ToleranceSpec:
     dwell_accuracy: float | None = None
     confidence: float = 0.9973
     allocation: Method = Method.RSS
+    evaluation: Evaluation = Evaluation.EXACT

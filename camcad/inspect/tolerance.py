@@ -32,8 +32,9 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.stats import norm
@@ -41,9 +42,12 @@ from scipy.stats import norm
 from camcad._typing import FloatArray, readonly
 from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
-from camcad.geometry.made import made_motion
+from camcad.geometry.made import MadeMotion, made_motion
 from camcad.geometry.sensitivity import Tol, applicable, mount_of, sensitivities
 from camcad.motion.segments import SegmentKind
+
+if TYPE_CHECKING:
+    from camcad.dynamics.spec import DynamicsSetup
 
 __all__ = [
     "PERCENTILES",
@@ -57,7 +61,9 @@ __all__ = [
     "draw",
     "dwell_angles",
     "linear_dwell",
+    "made_stress",
     "monte_carlo",
+    "quantities",
     "variant_figures",
 ]
 
@@ -207,7 +213,7 @@ def monte_carlo(
     dwell_err, acc, alpha = [], [], []
     for lo in range(0, samples, per):
         part = {k: v[lo : lo + per] for k, v in deltas.items()}
-        d_err, p_acc, p_alpha = variant_figures(cam, part, step=step, peaks=peaks)
+        d_err, p_acc, p_alpha, _ = variant_figures(cam, part, step=step, peaks=peaks)
         dwell_err.append(d_err)
         acc.append(p_acc)
         alpha.append(p_alpha)
@@ -245,18 +251,75 @@ def _grid(cam: Cam, dwell: FloatArray, step: float, peaks: bool) -> FloatArray:
     return out
 
 
+def made_stress(made: MadeMotion, setup: DynamicsSetup) -> FloatArray:
+    """Hertz contact stress [MPa] of made cams at their contacts, shaped as ``made.lift``.
+
+    The design's dynamic model (:func:`camcad.dynamics.model.contact_stress_at`)
+    fed with the made cam's own lift, velocity, acceleration and pressure
+    angle (the load) and its profile radius, roller radius and lever at the
+    contact (the curvature): Hertz line contact, Johnson 1985, eq. 4.45.
+    """
+    from camcad.dynamics.model import contact_stress_at
+    from camcad.motion.program import Motion
+
+    shape = made.lift.shape
+    flat = made.lift.ravel()
+    motion = Motion(
+        phi=np.broadcast_to(made.phi, shape).ravel(),
+        s=flat,
+        v=made.velocity.ravel(),
+        a=made.acceleration.ravel(),
+        j=np.zeros_like(flat),
+    )
+    lever = made.lever.ravel()
+    stress = contact_stress_at(
+        motion,
+        pressure_angle=made.pressure_angle.ravel(),
+        profile_rho=made.profile_rho.ravel(),
+        setup=setup,
+        lever=None if np.all(np.isnan(lever)) else lever,
+        roller_radius=made.roller_radius.ravel() if setup.roller_radius else None,
+    )
+    out: FloatArray = np.asarray(stress, dtype=float).reshape(shape)
+    return out
+
+
+Quantity = Callable[[MadeMotion], FloatArray]
+"""A figure of made cams at their contacts whose maximum is reported, shaped as ``made.lift``."""
+
+
+def quantities(setup: DynamicsSetup | None) -> dict[str, Quantity]:
+    """The peaked figures: |acceleration| [lift unit/rad²], |pressure angle| [rad], contact stress [MPa].
+
+    The stress is NaN without a dynamics setup, or for a groove (one flank's model only).
+    """
+
+    def stress(made: MadeMotion) -> FloatArray:
+        if setup is None or setup.flank_offsets is not None:
+            return np.full(made.lift.shape, np.nan)
+        return made_stress(made, setup)
+
+    return {
+        "acceleration": lambda made: np.abs(made.acceleration),
+        "pressure_angle": lambda made: np.abs(made.pressure_angle),
+        "stress": stress,
+    }
+
+
 def variant_figures(
     cam: Cam,
     deltas: Mapping[Tol, FloatArray],
     *,
     step: float = math.radians(1.0),
     peaks: bool = True,
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """One batch of made cams re-solved together: dwell errors (V, D), peak |a| (V,), peak |α| (V,).
+    setup: DynamicsSetup | None = None,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """One batch of made cams re-solved together: dwell errors (V, D), peak |a|, |α| and contact stress (V,).
 
     What :func:`monte_carlo` computes for each of its batches (see there for
-    the units); a batch's figures depend only on the variants in it, so the
-    same batches give the same bytes on any machine or worker.
+    the units; the stress in MPa, NaN without ``setup``); a batch's figures
+    depend only on the variants in it, so the same batches give the same
+    bytes on any machine or worker.
     """
     dwell = dwell_angles(cam)
     phi = _grid(cam, dwell, step, peaks)
@@ -267,16 +330,30 @@ def variant_figures(
     dwell_err: FloatArray = lift[:, where] - nominal[where]
     if not peaks:
         nan: FloatArray = np.full(lift.shape[0], np.nan)
-        return dwell_err, nan, nan.copy()
-    acc = _peak(cam, phi, np.abs(made.acceleration.reshape(-1, phi.size)), deltas, "acceleration")
-    alpha = _peak(cam, phi, np.abs(made.pressure_angle.reshape(-1, phi.size)), deltas, "pressure_angle")
-    return dwell_err, acc, alpha
+        return dwell_err, nan, nan.copy(), nan.copy()
+    found = [_peak(cam, phi, q(made).reshape(-1, phi.size), deltas, q) for q in quantities(setup).values()]
+    return dwell_err, found[0], found[1], found[2]
+
+
+def _golden(f: Callable[[FloatArray], FloatArray], a: FloatArray, b: FloatArray) -> FloatArray:
+    """Max of f on each bracket [a, b] by golden section (:data:`_REFINE` steps)."""
+    c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(_REFINE):
+        left = fc > fd  # the maximum lies in [a, d]
+        a, b = np.where(left, a, c), np.where(left, d, b)
+        x = np.where(left, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a))
+        fx = f(x)
+        c, d = np.where(left, x, d), np.where(left, c, x)
+        fc, fd = np.where(left, fx, fd), np.where(left, fc, fx)
+    out: FloatArray = np.maximum(fc, fd)
+    return out
 
 
 def _peak(
-    cam: Cam, grid: FloatArray, values: FloatArray, part: Mapping[Tol, FloatArray], what: str
+    cam: Cam, grid: FloatArray, values: FloatArray, part: Mapping[Tol, FloatArray], quantity: Quantity
 ) -> FloatArray:
-    """Each variant's max of |``what``|: its largest grid peaks, each refined by golden section.
+    """Each variant's max of ``quantity``: its largest grid peaks, each refined by golden section.
 
     The ``_CANDIDATES`` largest local maxima of the grid are refined between
     their neighbours on the re-solved motion (a rise and a return often peak
@@ -296,20 +373,9 @@ def _peak(
     phi_shape = (nv, ranked.shape[1])
 
     def f(x: FloatArray) -> FloatArray:
-        made = made_motion(cam, x.reshape(phi_shape), deltas=part)
-        got: FloatArray = getattr(made, what)
-        return np.abs(got).ravel()
+        return quantity(made_motion(cam, x.reshape(phi_shape), deltas=part)).ravel()
 
-    c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
-    fc, fd = f(c), f(d)
-    for _ in range(_REFINE):
-        left = fc > fd  # the maximum lies in [a, d]
-        a, b = np.where(left, a, c), np.where(left, d, b)
-        x = np.where(left, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a))
-        fx = f(x)
-        c, d = np.where(left, x, d), np.where(left, c, x)
-        fc, fd = np.where(left, fx, fd), np.where(left, fc, fx)
-    refined = np.max(np.maximum(fc, fd).reshape(phi_shape), axis=1)
+    refined = np.max(_golden(f, a, b).reshape(phi_shape), axis=1)
     out: FloatArray = np.maximum(np.max(values, axis=1), refined)
     return out
 

@@ -232,3 +232,26 @@ def test_the_shipped_sample_through_the_installed_entry(tmp_path):
         "tolerance.json",
         "tolerance.html",
     }
+
+
+def test_quadratic_evaluation_matches_the_exact_rows_within_its_certificate(serial, tmp_path):
+    """`evaluation = "quadratic"` on the same seed: every row within the bound tolerance.json reports."""
+    out, _ = serial
+    design = _design(tmp_path, SMALL + 'samples = 300\ndwell_accuracy = 0.02\nevaluation = "quadratic"\n')
+    assert main(["tolerance", str(design), "-o", str(tmp_path / "q"), "--format", "csv", "-q"]) == 0
+    exact, quad = _rows(out / "tolerance.csv"), _rows(tmp_path / "q" / "tolerance.csv")
+    summary = json.loads((tmp_path / "q" / "tolerance.json").read_text(encoding="utf-8"))
+    how = summary["evaluation"]
+    assert how["method"] == "quadratic" and how["certified_variants"] == 200
+    bound = how["max_abs_difference_from_exact"]
+    assert list(quad[0]) == list(exact[0])  # the same columns
+    for column, limit in bound.items():
+        key = column if column.startswith("peak") else None
+        names = [key] if key else [c for c in exact[0] if c.startswith("dwell_error_")]
+        for name in names:
+            e = np.array([float(r[name]) for r in exact if r[name]])
+            q = np.array([float(r[name]) for r in quad if r[name]])
+            assert e.size == q.size == 300
+            assert np.max(np.abs(e - q)) <= 2.0 * limit + 1e-12, name
+    for name in ("form_mm", "offset_mm", "phase_deg"):  # the same made cams
+        assert [r[name] for r in quad] == [r[name] for r in exact]

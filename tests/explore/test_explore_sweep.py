@@ -167,7 +167,7 @@ def test_processes_and_dask_give_the_same_bytes(small_plan, serial_csv, tmp_path
 
 
 def test_unreachable_scheduler_is_a_usage_error(tmp_path, capsys, monkeypatch):
-    import camcad.explore.sweep as engine
+    import camcad.explore.cluster as engine
 
     monkeypatch.setattr(engine, "SCHEDULER_TIMEOUT_S", 1)
     args = ["sweep", SAMPLE, "--grid", "base_radius=40:80:2", "--scheduler", "tcp://127.0.0.1:1"]
