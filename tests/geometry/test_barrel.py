@@ -516,7 +516,12 @@ def test_laws_and_lifts(law, lift, span, t):
 
 
 def rib_options(**kw: object) -> BarrelOptions:
-    base: dict[str, object] = {"kind": BarrelKind.RIB, "rib_width": 14.0, "depth": 15.0, "roller_length": 12.0}
+    base: dict[str, object] = {
+        "kind": BarrelKind.RIB,
+        "rib_width": 14.0,
+        "depth": 15.0,
+        "roller_length": 12.0,
+    }
     return options(**{**base, **kw})
 
 
@@ -577,7 +582,9 @@ def test_rib_faces_touch_their_roller_and_neither_roller_cuts_the_rib(follower, 
         e_r = np.stack((np.cos(phis), np.sin(phis), 0 * phis), axis=-1)[:, None, :]
         e_t = np.stack((-np.sin(phis), np.cos(phis), 0 * phis), axis=-1)[:, None, :]
         yz = own.centre(m).m0
-        axis_pt = st[None, :, None] * e_r + yz[:, None, 0:1] * e_t + yz[:, None, 1:2] * np.array([0.0, 0.0, 1.0])
+        axis_pt = (
+            st[None, :, None] * e_r + yz[:, None, 0:1] * e_t + yz[:, None, 1:2] * np.array([0.0, 0.0, 1.0])
+        )
         assert np.all(np.sum(sheet.normal * (axis_pt - sheet.point), axis=-1) > 0.0)
 
 
@@ -620,8 +627,9 @@ def test_rib_limits_against_brute_force():
     assert not lim.findings
     h, r_w = opt.rib_offset, 8.05
     # each face reaches farthest from the pitch line where the follower dwells: z0 ± (h − r_w) = z0 ± w/2
-    assert lim.z_range[0].value == pytest.approx(35.0 - 7.0, abs=1e-9)
-    assert lim.z_range[1].value == pytest.approx(65.0 + 7.0, abs=1e-9)
+    assert h - r_w == pytest.approx(7.0, abs=1e-12)
+    assert lim.z_range[0].value == pytest.approx(35.0 - (h - r_w), abs=1e-9)
+    assert lim.z_range[1].value == pytest.approx(65.0 + (h - r_w), abs=1e-9)
     v_max = 2.0 * 30.0 / (math.pi / 2.0)  # cycloidal: s′max = 2h/β (Rothbart 2004, §3.4)
     for ext, r in zip(lim.pressure_angle_max, (55.0, opt.pitch_station, 70.0), strict=True):
         assert ext.value == pytest.approx(math.atan(v_max / r), abs=1e-10)

@@ -190,3 +190,32 @@ def test_librecad_prints_the_developed_groove(tmp_path):
     pdf = dxf2pdf(path, tmp_path / "print")
     assert pdf.exists() and pdf.stat().st_size > 1000
     assert pdf.read_bytes().startswith(b"%PDF")
+
+
+def test_freecad_and_admesh_read_the_rib(tmp_path):
+    """The rib cam: FreeCAD reads its STEP as one valid solid, admesh its STL as one clean part."""
+    pytest.importorskip("OCP")
+    from camcad.export.barrel_mesh import barrel_mesh, barrel_stl_bytes
+    from camcad.export.barrel_step import barrel_shape, barrel_step_bytes
+    from camcad.fit.surface import fit_barrel_walls
+    from tests.barrel_cases import RIB
+    from tests.readers.test_admesh import MUST_BE_ZERO, admesh_report
+
+    freecad, admesh = require("freecadcmd"), require("admesh")
+    solid = barrel_shape(fit_barrel_walls(RIB.program, RIB.follower, RIB.options), RIB.options)
+    (tmp_path / "cam.step").write_bytes(barrel_step_bytes(solid, name="rib"))
+    (tmp_path / "script.py").write_text(FREECAD_SCRIPT, encoding="utf-8")
+    result = run([freecad, "script.py"], cwd=tmp_path)
+    lines = [s for s in result.stdout.splitlines() if s.startswith("RESULT ")]
+    assert len(lines) == 1, (result.stdout + result.stderr)[-3000:]
+    got = json.loads(lines[0][len("RESULT ") :])
+    assert got["solids"] == 1 and got["valid"] and got["bsplines"] >= 2
+    assert got["volume"] == pytest.approx(barrel_volume(RIB), rel=2e-4)
+    mesh = barrel_mesh(RIB.program, RIB.follower, RIB.options)
+    (tmp_path / "cam.stl").write_bytes(barrel_stl_bytes(mesh))
+    text = run([admesh, "cam.stl"], cwd=tmp_path)
+    report = admesh_report(text.stdout + text.stderr)
+    assert report["Number of parts"] == [1.0]
+    for key in MUST_BE_ZERO:
+        assert report[key] == [0.0], key
+    assert report["Volume"][0] == pytest.approx(barrel_volume(RIB), rel=1e-3)
