@@ -219,3 +219,98 @@ def test_freecad_and_admesh_read_the_rib(tmp_path):
     for key in MUST_BE_ZERO:
         assert report[key] == [0.0], key
     assert report["Volume"][0] == pytest.approx(barrel_volume(RIB), rel=1e-3)
+
+
+def _positions(moves, spacing: float, radius: float) -> tuple[np.ndarray, float]:
+    """Tool positions (x, y, a) dense along each feed block (X, Y, A linear within it), and the tip Z."""
+    out, tips = [], set()
+    for start, end in moves:
+        if start[3] == end[3] and start[0] == end[0]:
+            continue  # the plunge
+        tips.add(end[2])
+        length = math.hypot(math.radians(end[3] - start[3]) * radius, end[0] - start[0], end[1] - start[1])
+        n = max(2, math.ceil(length / spacing))
+        f = np.arange(n)[:, None] / n
+        out.append(start[[0, 1, 3]] + f * (end[[0, 1, 3]] - start[[0, 1, 3]]))
+    (tip,) = tips
+    return np.concatenate(out), tip
+
+
+def _swept_distance(points: np.ndarray, phi: np.ndarray, pos: np.ndarray, tip: float, r_tip: float, k: float):
+    """Signed distance of barrel-frame points from the body a tool sweeps through the positions.
+
+    The tool at (X, Y, A): its axis is the radial line at barrel angle θ = −A offset by y = −Y across it
+    at z = X (the program's header convention); its body is the surface of revolution of radius
+    r_tip + k·(t − tip) at station t ≥ tip along the axis. A point's signed distance from the flank is
+    (ρ − r(t))/√(1 + k²), ρ its distance from the axis; the min over the positions within 0.3 rad of
+    the point's own angle is the distance from the swept body (+: outside, −: the tool cut into it).
+    """
+    theta = -np.radians(pos[:, 2])
+    order = np.argsort(theta)
+    theta, pos = theta[order], pos[order]
+    out = np.full(len(points), np.inf)
+    for i, (p, ph) in enumerate(zip(points, phi, strict=True)):
+        lo, hi = np.searchsorted(theta, [ph - 0.3, ph + 0.3])
+        th, x, y = theta[lo:hi], pos[lo:hi, 0], -pos[lo:hi, 1]
+        c, s = np.cos(th), np.sin(th)
+        t = p[0] * c + p[1] * s
+        across = -p[0] * s + p[1] * c
+        rho = np.hypot(across - y, p[2] - x)
+        d = (rho - (r_tip + k * (t - tip))) / math.sqrt(1.0 + k * k)
+        d[t < tip - 1e-9] = np.inf
+        if d.size:
+            out[i] = d.min()
+    return out
+
+
+def test_rs274_runs_the_conical_program_and_the_tapered_cutter_sweeps_the_exact_walls(tmp_path):
+    """A conical roller's groove: rs274's moves, the tools swept along them, against the exact 3-D walls.
+
+    The tapered cutter's shape comes from the roller alone (taper k = r_f/t_p, apex on the barrel's
+    axis, tip radius k·b + c/2 at the groove's bottom b); each exact wall point at the groove's bottom,
+    pitch and top stations must lie on its swept body within the program's tolerance, from both walls
+    with the one pass; every roughing pass stays at least the stock inside both walls.
+    """
+    from dataclasses import replace
+
+    from camcad.geometry.barrel import RollerShape, barrel_walls
+
+    rs274 = require("rs274")
+    base = CASES["indexer"]
+    o = replace(base.options, roller=RollerShape.CONICAL)
+    spec = BarrelToolpathOptions(tolerance=0.005)
+    tp = plan_barrel(base.program, base.follower, o, spec)
+    text = render_barrel_program(tp, name="cone")
+    t_p = o.barrel_radius - 0.5 * o.roller_length
+    k = o.roller_radius / t_p
+    b = o.barrel_radius - o.depth
+    r_tip = k * b + 0.5 * o.clearance
+    assert f"tip D{2 * r_tip:.4f} at Z{b:.4f}" in text
+    assert f"half-angle {math.degrees(math.atan(k)):.4f} deg" in text
+    (tmp_path / "cam.ngc").write_text(text, encoding="ascii")
+    (tmp_path / "tools.tbl").write_text(f"T1 P1 Z0 D10 ;rough\nT2 P2 Z0 D{2 * r_tip:.4f} ;taper\n", "ascii")
+    proc = run([rs274, "-t", "tools.tbl", "-g", "cam.ngc", "canon.txt"], cwd=tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    passes = canon_passes((tmp_path / "canon.txt").read_text(encoding="ascii"))
+    assert [p["kind"] for p in passes] == ["rough"] * (len(passes) - 1) + ["finish both"]
+    phi = np.linspace(0.0, 2.0 * math.pi, 241, endpoint=False) + 1e-3
+    stations = np.array([b + 1e-3, t_p, o.barrel_radius])
+    walls = barrel_walls(base.program.evaluate(phi), base.follower, o, stations)
+    pts = np.concatenate([w.point.reshape(-1, 3) for w in (walls.upper, walls.lower)])
+    ph = np.tile(np.repeat(phi, stations.size), 2)
+    worst_rough = np.inf
+    for p in passes:
+        pos, tip = _positions(p["moves"], 0.05, o.barrel_radius)
+        if p["kind"] == "finish both":
+            assert tip == pytest.approx(b, abs=1e-4)
+            d = _swept_distance(pts, ph, pos, tip, r_tip, k)
+            print("cone finish", float(d.min()), float(d.max()))
+            # 4-decimal words and 0.05 mm position spacing (a sampled minimum over by < 1e-4 mm)
+            assert np.all(np.abs(d) <= spec.tolerance + 3e-4)
+        else:
+            d = _swept_distance(pts, ph, pos, tip, 0.5 * spec.rough_diameter, 0.0)
+            worst_rough = min(worst_rough, float(d.min()))
+    assert worst_rough >= spec.stock - spec.tolerance - 1e-4
+    # roughing plans for the cylinder of the tip's radius: at the pitch station (the lowest measured above
+    # the last level) it leaves the stock plus the cone's widening k·(t_p − b) there, no more
+    assert worst_rough <= spec.stock + k * (t_p - b) + 0.05

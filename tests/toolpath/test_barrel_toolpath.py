@@ -15,6 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from numpy.testing import assert_allclose
 
 from camcad.errors import DesignError
 from camcad.toolpath.barrel import BarrelToolpathOptions, plan_barrel, small_cutter_deviation
@@ -91,10 +92,41 @@ def test_bad_options_name_their_field(field, change):
     assert err.value.path == field
 
 
-def test_a_conical_roller_is_refused_naming_the_field():
+def test_a_rib_is_refused_naming_the_field():
+    from tests.barrel_cases import RIB
+
+    with pytest.raises(DesignError) as err:
+        plan_barrel(RIB.program, RIB.follower, RIB.options, BarrelToolpathOptions())
+    assert err.value.path == "cam.style"
+
+
+def test_a_conical_roller_is_finished_by_a_tapered_cutter_of_its_own_shape():
+    """One pass, the roller's own path, tip radius k·b + c/2 and taper k = r_f/t_p (apex on the axis).
+
+    The cutter's radius r_tip + k(t − b) equals the wall's roller radius k·t + c/2 at every station t
+    (the identity that makes the one pass exact; the swept walls are measured in test_barrel_readers).
+    """
     from camcad.geometry.barrel import RollerShape
 
-    options = replace(INDEXER.options, roller=RollerShape.CONICAL)
-    with pytest.raises(DesignError) as err:
-        plan_barrel(INDEXER.program, INDEXER.follower, options, BarrelToolpathOptions())
-    assert err.value.path == "follower.roller"
+    o = replace(INDEXER.options, roller=RollerShape.CONICAL)
+    tp = plan_barrel(INDEXER.program, INDEXER.follower, o, BarrelToolpathOptions(tolerance=0.01))
+    finish = [p for p in tp.passes if p.kind.startswith("finish")]
+    assert [p.kind for p in finish] == ["finish both"]
+    (f,) = finish
+    k = 8.0 / (70.0 - 14.0 / 2.0)
+    b = 70.0 - 18.0
+    assert f.taper == pytest.approx(k, rel=1e-12)
+    assert f.radius == pytest.approx(k * b + 0.025, rel=1e-12)
+    assert f.z == b and f.shift == 0.0
+    for t in (b, 61.0, 70.0):
+        assert f.radius + f.taper * (t - f.z) == pytest.approx(
+            float(o.roller_at(t, clearance=True)), abs=1e-12
+        )
+    # on the roller's own path: X = z0 + s, Y = 0, A = −φ
+    phi = -np.radians(f.a)
+    assert_allclose(f.x, 30.0 + INDEXER.program.evaluate(phi).s, atol=1e-12)
+    assert np.all(f.y == 0.0)
+    assert tp.max_deviation <= 0.01
+    # roughing keeps the stock inside the cylinder of the tip's radius
+    for p in tp.passes[:-1]:
+        assert abs(p.shift) + p.radius <= f.radius - 0.2 + 1e-12
