@@ -314,3 +314,47 @@ def test_rs274_runs_the_conical_program_and_the_tapered_cutter_sweeps_the_exact_
     # roughing plans for the cylinder of the tip's radius: at the pitch station (the lowest measured above
     # the last level) it leaves the stock plus the cone's widening k·(t_p − b) there, no more
     assert worst_rough <= spec.stock + k * (t_p - b) + 0.05
+
+
+def test_rs274_roughing_clears_the_groove_to_the_stock_and_the_flanks_estimate(tmp_path):
+    """The roughing cutter's stepover passes, rebuilt from rs274's moves, in the developed plane.
+
+    At the pitch station and the top (above every level's tip): every point across the groove within
+    the stock of the walls is inside some roughing disc (the stepover leaves no ridge), and what the
+    discs leave on each wall lies between the stock and the stock plus the outermost pass's flank
+    error: its axis is δ = r_w − r_c − stock off the path along the pitch station's normal, so on the
+    steepest flank it leaves δ(1 − cos(β_t − β_p)) more, tan β = s′/t (a 1 % margin for the turn's
+    largest, just off the steepest point, as test_barrel_toolpath measures).
+    """
+    rs274 = require("rs274")
+    c, tp = CASES["indexer"], planned("indexer")
+    (tmp_path / "cam.ngc").write_text(render_barrel_program(tp, name="indexer"), encoding="ascii")
+    (tmp_path / "tools.tbl").write_text("T1 P1 Z0 D10 ;rough\nT2 P2 Z0 D16 ;finish\n", encoding="ascii")
+    proc = run([rs274, "-t", "tools.tbl", "-g", "cam.ngc", "canon.txt"], cwd=tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    rough = [
+        p for p in canon_passes((tmp_path / "canon.txt").read_text(encoding="ascii")) if p["kind"] == "rough"
+    ]
+    o, spec = c.options, tp.options
+    r_w, r_c = o.roller_radius + 0.5 * o.clearance, 0.5 * spec.rough_diameter
+    reach = r_w - r_c - spec.stock
+    shifts = sorted({round(p.shift, 9) for p in tp.passes if p.kind == "rough"})
+    assert len(shifts) >= 2 and np.max(np.diff(shifts)) <= spec.stepover * spec.rough_diameter + 1e-12
+    phi = np.linspace(0.0, 2.0 * math.pi, 20_001)
+    motion = c.program.evaluate(phi)
+    v_star = float(np.max(motion.v))
+    for t in (o.pitch_station, o.barrel_radius):
+        axes = [centres(p["moves"], t) for p in rough]
+        pts = np.concatenate([a for a, tip in axes if tip <= t])
+        period = np.array([2.0 * math.pi * t, 0.0])
+        tree = cKDTree(np.vstack((pts - period, pts, pts + period)))
+        walls = developed_walls(motion, c.follower, o, t)
+        for wall in (walls.upper.point, walls.lower.point):
+            left = tree.query(wall)[0] - r_c
+            flank = reach * (1.0 - math.cos(math.atan(v_star / t) - math.atan(v_star / o.pitch_station)))
+            assert left.min() >= spec.stock - spec.tolerance - 1e-3
+            assert left.max() <= spec.stock + 1.01 * flank + spec.tolerance + 1e-3
+        # across the groove, the pitch line and its offsets up to the stock from the walls: all cut
+        for frac in np.linspace(-1.0, 1.0, 9):
+            inside = walls.pitch.point + frac * (r_w - spec.stock - 0.05) * walls.pitch.normal
+            assert tree.query(inside)[0].max() < r_c
