@@ -320,3 +320,26 @@ def test_rib_developed_dxf_holds_both_faces(tmp_path):
         assert np.abs(d - (r_w if sign else 0.0)).max() <= 0.005 + 0.002
         if sign:
             assert np.all(sign * (pts[:, 1] - path_pts[idx, 1]) < 0.0)  # on the rib's side of the roller
+
+
+@pytest.mark.parametrize("variant", ["arm", "cone"])
+def test_an_arm_rib_and_a_conical_rib_are_valid_with_the_quadratures_volume(variant):
+    """A rib on an arm's yoke and a rib between conical rollers: BRepCheck valid, the quadrature's volume."""
+    from dataclasses import replace
+
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    from camcad.export.barrel_step import barrel_shape
+    from camcad.geometry.barrel import BarrelKind, RollerShape
+    from tests.barrel_cases import ARM, RIB
+
+    if variant == "arm":
+        o = replace(ARM.options, kind=BarrelKind.RIB, rib_width=12.0, depth=15.0, roller_length=12.0)
+        case = replace(ARM, name="arm-rib", options=o)
+    else:
+        case = replace(RIB, name="cone-rib", options=replace(RIB.options, roller=RollerShape.CONICAL))
+    fit = fit_barrel_walls(case.program, case.follower, case.options)
+    assert fit.max_error <= fit.tolerance
+    s = barrel_shape(fit, case.options)
+    assert BRepCheck_Analyzer(s.shape).IsValid()
+    assert s.volume == pytest.approx(barrel_volume(case), abs=0.05)

@@ -656,3 +656,32 @@ def test_a_rib_too_narrow_for_its_flank_vanishes():
         check_barrel(rib_options(rib_width=0.0), TRANSLATING)
     assert err.value.path == "cam.rib_width"
     assert exit_code(err.value) == EXIT_INVALID
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    law=st.sampled_from(["cycloidal", "poly-345", "harmonic", "modified-sine"]),
+    lift=st.floats(2.0, 40.0),
+    span=st.floats(60.0, 170.0),
+    width=st.floats(4.0, 30.0),
+    t=st.floats(55.0, 70.0),
+)
+def test_rib_faces_for_any_law(law, lift, span, width, t):
+    """Any translating rib: each developed face is r_w from its roller's path, on the rib's side, and
+    the faces are the rib's width apart (exactly, along z) wherever the follower dwells."""
+    prog = program(lift, law=law, span_deg=span)
+    m = prog.evaluate(PHI)
+    opt = rib_options(rib_width=width)
+    h, r_w = opt.rib_offset, opt.roller_radius + 0.5 * opt.clearance
+    up_roller, low_roller = rib_rollers(TRANSLATING, opt)
+    upper = developed_walls(m, up_roller, opt, t).lower
+    lower = developed_walls(m, low_roller, opt, t).upper
+    for face, sign in ((upper, 1.0), (lower, -1.0)):
+        path = np.column_stack((t * PHI, 35.0 + sign * h + m.s))
+        offset = face.point - path
+        assert_allclose(np.hypot(offset[:, 0], offset[:, 1]), r_w, atol=1e-10)
+        # along the path's normal (−s′, t)/D, towards the rib
+        normal = np.column_stack((-m.v, np.full_like(m.v, t))) / np.hypot(m.v, t)[:, None]
+        assert_allclose(np.sum(offset * normal, axis=1), -sign * r_w, atol=1e-10)
+    dwell = np.abs(m.v) < 1e-12
+    assert_allclose(upper.point[dwell, 1] - lower.point[dwell, 1], width, atol=1e-10)
