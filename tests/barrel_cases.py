@@ -1,9 +1,10 @@
-"""The two barrel cams of issue 36, as code until the design file has a barrel (issue 33).
+"""The two barrel cams of issue 36, and a rib cam, as code until the design file has a barrel (issue 33).
 
 - ``indexer``: an indexer's barrel cam, a translating roller with a radial axis,
   dwell – index 40 mm (modified sine, 100°) – dwell – return (modified sine, 100°);
 - ``arm``: an arm-driven barrel cam, a cylindrical roller on an arm of 110 mm about a
-  pivot 100 mm off the barrel's axis, swinging 12° (poly-345 over 100°) and back.
+  pivot 100 mm off the barrel's axis, swinging 12° (poly-345 over 100°) and back;
+- ``RIB``: a rib 14 mm wide straddled by two translating rollers, index 30 mm (modified sine).
 
 The TOML they stand for (keys proposed in the report) is in each case's ``toml``.
 """
@@ -15,6 +16,7 @@ from dataclasses import dataclass
 
 from camcad.geometry.barrel import (
     BarrelFollower,
+    BarrelKind,
     BarrelOptions,
     OscillatingBarrelRoller,
     TranslatingBarrelRoller,
@@ -143,7 +145,7 @@ angle = 80.0
 """,
 )
 
-CASES = {c.name: c for c in (INDEXER, ARM)}
+CASES = {c.name: c for c in (INDEXER, ARM)}  # grooves; RIB (below) is the rib
 
 
 def groove_volume(case: BarrelCase, *, angles: int = 7200, radii: int = 12) -> float:
@@ -157,7 +159,7 @@ def groove_volume(case: BarrelCase, *, angles: int = 7200, radii: int = 12) -> f
     """
     import numpy as np
 
-    from camcad.geometry.barrel import WallSide, walls_at_radius
+    from camcad.geometry.barrel import WallSide, faces_at_radius
 
     o = case.options
     phi = np.linspace(0.0, 2.0 * math.pi, angles, endpoint=False)
@@ -169,7 +171,7 @@ def groove_volume(case: BarrelCase, *, angles: int = 7200, radii: int = 12) -> f
         rho = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
         area = 0.0
         for side, sign in ((WallSide.UPPER, 1.0), (WallSide.LOWER, -1.0)):
-            pts = walls_at_radius(motion, case.follower, o, rho, side)[1].point[:, 0]
+            pts = faces_at_radius(motion, case.follower, o, rho, side)[1].point[:, 0]
             theta = np.unwrap(np.arctan2(pts[:, 1], pts[:, 0]))
             z = pts[:, 2]
             dtheta = np.diff(np.r_[theta, theta[0] + 2.0 * math.pi])
@@ -179,6 +181,62 @@ def groove_volume(case: BarrelCase, *, angles: int = 7200, radii: int = 12) -> f
 
 
 def barrel_volume(case: BarrelCase) -> float:
-    """The blank less the bore less the groove [mm³]."""
+    """The blank less the bore less the groove [mm³]; a rib: the core less the bore plus the rib.
+
+    For a rib the same quadrature over its faces (upper minus lower) is the rib's volume.
+    """
     o = case.options
+    if o.kind is BarrelKind.RIB:
+        return math.pi * (o.bottom_radius**2 - (0.5 * o.bore) ** 2) * o.length + groove_volume(case)
     return math.pi * (o.barrel_radius**2 - (0.5 * o.bore) ** 2) * o.length - groove_volume(case)
+
+
+RIB = BarrelCase(
+    name="rib",
+    program=_program(30.0, "modified-sine", 100.0),
+    follower=TranslatingBarrelRoller(axial_position=40.0),
+    options=BarrelOptions(
+        barrel_radius=70.0,
+        length=110.0,
+        depth=15.0,
+        bore=40.0,
+        roller_radius=8.0,
+        roller_length=12.0,
+        clearance=0.05,
+        kind=BarrelKind.RIB,
+        rib_width=14.0,
+    ),
+    toml="""\
+# An indexer's rib cam: two rollers straddle a 14 mm rib that indexes them 30 mm along the axis.
+[cam]
+style = "barrel-rib"
+barrel_radius = 70.0   # mm, the rib's top
+length = 110.0
+bore = 40.0
+rib_width = 14.0       # mm along the axis, at the pitch radius, where the follower dwells
+[groove]
+depth = 15.0           # the rib's height
+clearance = 0.05
+[follower]
+type = "translating-roller"
+roller_radius = 8.0
+roller_length = 12.0
+axial_position = 40.0  # mm, the rib's middle at φ = 0
+[[motion]]
+kind = "rise"
+law = "modified-sine"
+angle = 100.0
+lift = 30.0
+[[motion]]
+kind = "dwell"
+angle = 80.0
+[[motion]]
+kind = "return"
+law = "modified-sine"
+angle = 100.0
+lift = 30.0
+[[motion]]
+kind = "dwell"
+angle = 80.0
+""",
+)

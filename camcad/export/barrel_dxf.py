@@ -6,7 +6,9 @@ y = w = z along its axis, both walls and the pitch line are fitted as open
 cubic B-splines (:func:`camcad.fit.fit_points`, within ``tolerance`` [mm] of
 the exact points every 0.1°) and written as SPLINE entities on the layers
 ``WALL_UPPER``, ``WALL_LOWER`` and ``PITCH``; two LINEs mark the developed
-barrel's ends (φ = 0 and 2π).
+barrel's ends (φ = 0 and 2π). A rib's faces
+(:func:`~camcad.geometry.barrel.face_rollers`) go on the same two wall
+layers, the follower's pitch line (between its rollers) on ``PITCH``.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import numpy as np
 from camcad.export._ezdxf import import_ezdxf, save_reproducible
 from camcad.fit import fit_points
 from camcad.fit.result import ProfileFit
-from camcad.geometry.barrel import BarrelFollower, BarrelOptions
+from camcad.geometry.barrel import BarrelFollower, BarrelOptions, WallSide, face_rollers
 from camcad.geometry.barrel_limits import developed_walls
 from camcad.motion.program import MotionProgram
 
@@ -45,14 +47,17 @@ def developed_groove(
     tolerance: float = 0.005,
     step: float = math.radians(0.1),
 ) -> DevelopedGroove:
-    """Fit the developed pitch line and walls at the pitch station within ``tolerance`` [mm]."""
+    """Fit the developed pitch line and walls (a rib's faces) at the pitch station within ``tolerance``."""
     n = math.ceil(math.tau / step)
     phi = np.linspace(0.0, math.tau, n + 1)
-    walls = developed_walls(program.evaluate(phi), follower, options, options.pitch_station)
-    fits = [
-        fit_points(np.asarray(c.point), closed=False, tolerance=tolerance)
-        for c in (walls.pitch, walls.upper, walls.lower)
-    ]
+    motion = program.evaluate(phi)
+    tp = options.pitch_station
+    pitch = developed_walls(motion, follower, options, tp).pitch.point
+    faces = []
+    for roller, side in face_rollers(follower, options):
+        walls = developed_walls(motion, roller, options, tp)
+        faces.append((walls.upper if side is WallSide.UPPER else walls.lower).point)
+    fits = [fit_points(np.asarray(c), closed=False, tolerance=tolerance) for c in (pitch, *faces)]
     return DevelopedGroove(station=options.pitch_station, pitch=fits[0], upper=fits[1], lower=fits[2])
 
 

@@ -1,4 +1,4 @@
-"""A barrel cam as a watertight triangle mesh (manifold3d): the blank minus the groove.
+"""A barrel cam as a watertight triangle mesh (manifold3d): the blank minus the groove, or with its rib.
 
 The groove is meshed straight from the exact walls
 (:func:`camcad.geometry.barrel.barrel_walls`) as a ring: at each motion
@@ -7,7 +7,9 @@ over the stations t₀ … t₁ (:func:`camcad.fit.surface.wall_station_range`:
 from inside the groove's bottom cylinder to outside the barrel) and back
 along the lower wall; consecutive sections are joined by quads. manifold3d
 cuts it with the bottom cylinder and subtracts it from the blank (a
-cylinder less the bore), all polygons with at most ``chord`` [mm] of sag.
+cylinder less the bore), all polygons with at most ``chord`` [mm] of sag. A
+rib's ring (between its faces, :func:`~camcad.geometry.barrel.barrel_faces`)
+is intersected with the blank and joined to the core cylinder instead.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from camcad._typing import FloatArray
 from camcad.errors import ExportError
 from camcad.export._triangles import TriangleMesh, stl_bytes
 from camcad.fit.surface import wall_station_range
-from camcad.geometry.barrel import BarrelFollower, BarrelOptions, barrel_walls
+from camcad.geometry.barrel import BarrelFollower, BarrelKind, BarrelOptions, barrel_faces
 from camcad.motion.program import MotionProgram
 
 __all__ = ["BarrelMeshOptions", "barrel_mesh", "barrel_stl_bytes"]
@@ -37,9 +39,16 @@ class BarrelMeshOptions:
     stations: int = 9
 
 
-def _segments(radius: float, chord: float) -> int:
-    """Polygon sides so that the sag r(1 − cos(π/n)) ≤ chord."""
-    return max(16, math.ceil(math.pi / math.acos(max(1.0 - chord / radius, -1.0))))
+def _segments(radius: float, chord: float, angles: int) -> int:
+    """Polygon sides so that the sag r(1 − cos(π/n)) ≤ chord, n dividing ``angles`` where it can.
+
+    With n dividing the sections' count (and the polygon turned by half a
+    section's step, :func:`barrel_mesh`) no vertical edge of a cylinder comes
+    near a section of the ring: near-coincident ones leave slivers thinner
+    than float32, which an STL reader welds into non-manifold edges.
+    """
+    need = max(16, math.ceil(math.pi / math.acos(max(1.0 - chord / radius, -1.0))))
+    return next((n for n in range(need, angles + 1) if angles % n == 0), need)
 
 
 def _ring(walls_upper: FloatArray, walls_lower: FloatArray) -> tuple[FloatArray, np.ndarray]:
@@ -91,22 +100,31 @@ def barrel_mesh(
     phi = np.linspace(0.0, math.tau, mesh.angles, endpoint=False)
     phi = np.union1d(phi, np.mod([bp.phi for bp in program.breakpoints], math.tau))
     t0, t1 = wall_station_range(program, follower, options, margin)
-    walls = barrel_walls(program.evaluate(phi), follower, options, np.linspace(t0, t1, mesh.stations))
+    walls = barrel_faces(program.evaluate(phi), follower, options, np.linspace(t0, t1, mesh.stations))
     tool = _manifold(*_ring(walls.upper.point, walls.lower.point))
     if tool.volume() < 0.0 or tool.status() != manifold3d.Error.NoError:
         raise ExportError(f"the groove's ring mesh is not a solid: manifold3d reports {tool.status().name}")
 
     def cylinder(radius: float, z0: float, height: float) -> manifold3d.Manifold:
-        return manifold3d.Manifold.cylinder(height, radius, radius, _segments(radius, mesh.chord)).translate(
-            (0.0, 0.0, z0)
+        sides = _segments(radius, mesh.chord, mesh.angles)
+        half_step = 180.0 / mesh.angles  # [deg]: the polygon's vertices midway between the ring's sections
+        return (
+            manifold3d.Manifold.cylinder(height, radius, radius, sides)
+            .rotate((0.0, 0.0, half_step))
+            .translate((0.0, 0.0, z0))
         )
 
     blank = cylinder(o.barrel_radius, 0.0, o.length)
+    if o.kind is BarrelKind.RIB:  # the ring is the rib: within the blank, on the core
+        blank = (blank ^ tool) + cylinder(o.bottom_radius, 0.0, o.length)
     if o.bore > 0.0:
         blank = blank - cylinder(0.5 * o.bore, -1.0, o.length + 2.0)
-    extent = 2.0 * (o.length + t1)
-    groove = tool - cylinder(o.bottom_radius, -extent, 2.0 * extent + o.length)
-    solid = blank - groove
+    if o.kind is BarrelKind.RIB:
+        solid = blank
+    else:
+        extent = 2.0 * (o.length + t1)
+        groove = tool - cylinder(o.bottom_radius, -extent, 2.0 * extent + o.length)
+        solid = blank - groove
     if solid.status() != manifold3d.Error.NoError or solid.is_empty():
         raise ExportError(f"the barrel's mesh failed: manifold3d reports {solid.status().name}")
     out = solid.to_mesh()

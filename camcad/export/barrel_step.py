@@ -1,4 +1,4 @@
-"""STEP (AP214) solid of a barrel cam, built with OpenCASCADE: the barrel with its groove cut.
+"""STEP (AP214) solid of a barrel cam, built with OpenCASCADE: the barrel with its groove cut (or its rib).
 
 The solid is the blank (a cylinder of ``barrel_radius`` and ``length`` less
 the bore) minus the groove; the groove is the region between the two wall
@@ -124,6 +124,22 @@ def _cut(a: Any, b: Any, what: str) -> Any:
     return op.Shape()
 
 
+def _boolean(kind: str, a: Any, b: Any, what: str) -> Any:
+    """``Common`` or ``Fuse`` of two shapes (a fuse with its coplanar faces merged)."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Fuse
+
+    op = BRepAlgoAPI_Common(a, b) if kind == "common" else BRepAlgoAPI_Fuse(a, b)
+    if not op.IsDone():
+        raise ExportError(f"OpenCASCADE could not {kind} {what}")
+    if kind == "common":
+        return op.Shape()
+    from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
+
+    unify = ShapeUpgrade_UnifySameDomain(op.Shape(), True, True, False)
+    unify.Build()
+    return unify.Shape()
+
+
 def _groove_tool(fit: BarrelWallFit) -> Any:
     """The closed ring between the walls over the fitted stations."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_Sewing
@@ -153,7 +169,11 @@ def _groove_tool(fit: BarrelWallFit) -> Any:
 
 
 def barrel_shape(fit: BarrelWallFit, options: BarrelOptions) -> BarrelSolid:
-    """The barrel with its groove as one OpenCASCADE solid, checked by ``BRepCheck_Analyzer``.
+    """The barrel with its groove (or rib) as one OpenCASCADE solid, checked by ``BRepCheck_Analyzer``.
+
+    A groove: the blank less the ring between the walls above the bottom
+    cylinder. A rib (``options.kind``): the ring between its faces within the
+    blank, fused with the core cylinder (radius R − depth), less the bore.
 
     Raises
     ------
@@ -166,14 +186,22 @@ def barrel_shape(fit: BarrelWallFit, options: BarrelOptions) -> BarrelSolid:
     from OCP.TopAbs import TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
 
+    from camcad.geometry.barrel import BarrelKind
+
     o = options
     blank = _cylinder(o.barrel_radius, 0.0, o.length)
+    if o.kind is BarrelKind.RIB:
+        rib = _boolean("common", _groove_tool(fit), blank, "the rib with the blank")
+        blank = _boolean("fuse", _cylinder(o.bottom_radius, 0.0, o.length), rib, "the rib onto the core")
     if o.bore > 0.0:
         blank = _cut(blank, _cylinder(0.5 * o.bore, -1.0, o.length + 2.0), "the bore")
-    reach = fit.upper.station_range[1] - fit.upper.station_range[0]
-    inner = _cylinder(o.bottom_radius, -reach - o.length, 3.0 * o.length + 2.0 * reach)
-    groove = _cut(_groove_tool(fit), inner, "the groove's bottom")
-    shape = _cut(blank, groove, "the groove")
+    if o.kind is BarrelKind.RIB:
+        shape = blank
+    else:
+        reach = fit.upper.station_range[1] - fit.upper.station_range[0]
+        inner = _cylinder(o.bottom_radius, -reach - o.length, 3.0 * o.length + 2.0 * reach)
+        groove = _cut(_groove_tool(fit), inner, "the groove's bottom")
+        shape = _cut(blank, groove, "the groove")
     solids = 0
     explorer = TopExp_Explorer(shape, TopAbs_SOLID)
     while explorer.More():

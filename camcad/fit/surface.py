@@ -1,7 +1,7 @@
 """Certified tensor-product B-spline surfaces of a barrel cam's groove walls.
 
-Each wall W(φ, t) (:func:`camcad.geometry.barrel.barrel_walls`: motion angle
-φ × station t along the roller's axis) is fitted by a bicubic B-spline
+Each wall W(φ, t) (:func:`camcad.geometry.barrel.barrel_faces`: motion angle
+φ × station t along the roller's axis; a rib's two faces likewise) is fitted by a bicubic B-spline
 S(u, v), periodic in u = φ/2π and clamped in v = (t − t₀)/(t₁ − t₀), with the
 plate profile's least-squares kernels (:func:`~camcad.fit.bspline.lsq_periodic`,
 :func:`~camcad.fit.bspline.lsq_clamped`): one periodic solve in u fits every
@@ -46,7 +46,7 @@ from camcad.errors import FitError
 from camcad.fit.bspline import lsq_clamped, lsq_periodic, periodic_curve
 from camcad.fit.certify import CERT_SAFETY
 from camcad.fit.curve import BSplineCurve
-from camcad.geometry.barrel import BarrelFollower, BarrelOptions, WallSide, barrel_walls
+from camcad.geometry.barrel import BarrelFollower, BarrelOptions, WallSide, barrel_faces, face_rollers
 from camcad.motion.program import MotionProgram
 
 __all__ = [
@@ -180,10 +180,11 @@ def wall_station_range(
 
     A wall point at station t lies √(t² + (y + r cos γ)²) from the barrel's
     axis, between t and √(t² + (|y| + r)²); so t₀ = √(b² − (|y|max + r)²) − margin
-    (b the bottom radius) and t₁ = R + margin.
+    (b the bottom radius) and t₁ = R + margin; |y| over a rib's two rollers.
     """
     phi = program.sample_phi(math.radians(1.0))
-    y = float(np.max(np.abs(follower.centre(program.evaluate(phi)).m0[:, 0])))
+    motion = program.evaluate(phi)
+    y = max(float(np.max(np.abs(src.centre(motion).m0[:, 0]))) for src, _ in face_rollers(follower, options))
     r = float(options.roller_at(options.bottom_radius, clearance=True))
     bottom = options.bottom_radius
     reach = y + r
@@ -232,7 +233,7 @@ def _exact(
     side: WallSide,
 ) -> FloatArray:
     """W (n, m, 3) [mm], taking each joint's right-hand limit (the surface's knots are there too)."""
-    walls = barrel_walls(program.evaluate(phi), follower, options, stations)
+    walls = barrel_faces(program.evaluate(phi), follower, options, stations)
     return walls.upper.point if side is WallSide.UPPER else walls.lower.point
 
 
@@ -285,7 +286,7 @@ def _certify(
     joints = np.array([bp.phi for bp in program.breakpoints])
     node = float(np.max(np.linalg.norm(err, axis=-1)))
     if joints.size:
-        left = barrel_walls(program.evaluate(joints, side="left"), follower, options, t)
+        left = barrel_faces(program.evaluate(joints, side="left"), follower, options, t)
         w_left = left.upper.point if side is WallSide.UPPER else left.lower.point
         node = max(node, float(np.max(np.linalg.norm(surface.at(joints, t) - w_left, axis=-1))))
     wrapped = np.concatenate((err[-1:], err, err[:1]), axis=0)  # periodic in φ

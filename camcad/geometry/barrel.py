@@ -68,16 +68,23 @@ from camcad.motion.program import Motion
 
 __all__ = [
     "BarrelFollower",
+    "BarrelKind",
     "BarrelOptions",
     "BarrelWalls",
+    "FaceSource",
     "OscillatingBarrelRoller",
+    "RibRoller",
     "RollerShape",
     "Slip",
     "TranslatingBarrelRoller",
     "WallSheet",
     "WallSide",
+    "barrel_faces",
     "barrel_walls",
     "check_barrel",
+    "face_rollers",
+    "faces_at_radius",
+    "rib_rollers",
     "roller_slip",
     "walls_at_radius",
 ]
@@ -88,6 +95,19 @@ class RollerShape(enum.Enum):
 
     CYLINDRICAL = "cylindrical"
     CONICAL = "conical"
+
+
+class BarrelKind(enum.Enum):
+    """A ``GROOVE`` cut into the barrel (one roller runs between its walls) or a ``RIB`` standing on it.
+
+    A rib is straddled by two rollers on the same follower, one on each side
+    (the rib form of the cylindrical cam, Rothbart 2004, ch. 1):
+    each of the rib's faces is the same 3-D envelope as a groove's wall, of
+    one roller, with the material on the other side.
+    """
+
+    GROOVE = "groove"
+    RIB = "rib"
 
 
 class WallSide(enum.Enum):
@@ -107,6 +127,13 @@ class BarrelOptions:
     r_f (a cone's radius at the pitch station), ``roller_length`` ℓ (the
     roller reaches from the barrel's surface to station R − ℓ, its pitch
     station t_p = R − ℓ/2), and the roller's shape.
+
+    ``kind`` :attr:`BarrelKind.RIB`: a rib of height ``depth`` (its top at
+    R, the barrel's core of radius R − depth) and of ``rib_width`` w [mm]
+    along the barrel's axis where the follower dwells, at the pitch station;
+    its two rollers' axes stand ±h = ±(w/2 + r_f + c/2) from the follower's
+    pitch path (:attr:`rib_offset`), so each face clears its roller by c/2
+    as a groove's wall does.
     """
 
     barrel_radius: float
@@ -117,6 +144,15 @@ class BarrelOptions:
     bore: float = 0.0
     clearance: float = 0.0
     roller: RollerShape = RollerShape.CYLINDRICAL
+    kind: BarrelKind = BarrelKind.GROOVE
+    rib_width: float = 0.0
+
+    @property
+    def rib_offset(self) -> float:
+        """The rib rollers' offset h = w/2 + r_f + c/2 [mm] from the pitch path (0 for a groove)."""
+        if self.kind is BarrelKind.GROOVE:
+            return 0.0
+        return 0.5 * self.rib_width + self.roller_radius + 0.5 * self.clearance
 
     @property
     def bottom_radius(self) -> float:
@@ -198,7 +234,41 @@ class OscillatingBarrelRoller:
         return out
 
 
-BarrelFollower = TranslatingBarrelRoller | OscillatingBarrelRoller
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RibRoller:
+    """One of a rib's two rollers: carried by ``follower``, ``offset`` h [mm] from its pitch path.
+
+    The offset is along the direction the follower drives the roller's axis
+    and moves rigidly with the follower: +z for a translating follower; for
+    an arm, a yoke across the arm's end, so the roller sits at
+    P + l·e(b) + h·(sin b, −cos b) = P + L·e(b − β), L = √(l² + h²),
+    tan β = h/l (the arm's kinematics with a longer arm turned by −β).
+    """
+
+    follower: TranslatingBarrelRoller | OscillatingBarrelRoller
+    offset: float  # h [mm], + towards the follower's rise
+
+    def centre(self, motion: Motion) -> PointElement:
+        """(y, z) of this roller's axis and its φ-derivatives (see the class notes)."""
+        f = self.follower
+        if isinstance(f, TranslatingBarrelRoller):
+            return slide_point(0.0, f.axial_position + self.offset, motion)
+        psi, d1, d2, d3 = arm_swing(motion)
+        beta = math.atan2(self.offset, f.arm_length)
+        length = math.hypot(f.arm_length, self.offset)
+        return turning_point(f.pivot, length, (f.initial_arm_angle - beta - psi, -d1, -d2, -d3))
+
+    def driven(self, motion: Motion) -> FloatArray:
+        """(n, 2) unit (y, z) direction this roller's axis moves in as the lift grows."""
+        f = self.follower
+        if isinstance(f, TranslatingBarrelRoller):
+            return f.driven(motion)
+        b = f.initial_arm_angle - math.atan2(self.offset, f.arm_length) - arm_swing(motion)[0]
+        out: FloatArray = np.column_stack((np.sin(b), -np.cos(b)))
+        return out
+
+
+BarrelFollower = TranslatingBarrelRoller | OscillatingBarrelRoller | RibRoller
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -379,6 +449,75 @@ def walls_at_radius(
     return out_t, _sheet(phi, c, k)
 
 
+def rib_rollers(
+    follower: TranslatingBarrelRoller | OscillatingBarrelRoller, options: BarrelOptions
+) -> tuple[RibRoller, RibRoller]:
+    """A rib's two rollers: (+h, on the rib's +z side; −h, on its −z side), h: ``options.rib_offset``."""
+    h = options.rib_offset
+    return RibRoller(follower=follower, offset=h), RibRoller(follower=follower, offset=-h)
+
+
+FaceSource = tuple[BarrelFollower, WallSide]
+
+
+def face_rollers(follower: BarrelFollower, options: BarrelOptions) -> tuple[FaceSource, FaceSource]:
+    """Which roller, and which of its walls, bounds the material on the +z side and on the −z side.
+
+    A groove: the follower's one roller, its (upper, lower) walls. A rib
+    (:class:`BarrelKind`): its upper face is the lower wall of the roller at
+    +h, its lower face the upper wall of the roller at −h.
+    """
+    if options.kind is BarrelKind.GROOVE or isinstance(follower, RibRoller):
+        return (follower, WallSide.UPPER), (follower, WallSide.LOWER)
+    up, low = rib_rollers(follower, options)
+    return (up, WallSide.LOWER), (low, WallSide.UPPER)
+
+
+def _side_sheet(walls: BarrelWalls, side: WallSide) -> WallSheet:
+    return walls.upper if side is WallSide.UPPER else walls.lower
+
+
+def barrel_faces(
+    motion: Motion, follower: BarrelFollower, options: BarrelOptions, station: FloatArray
+) -> BarrelWalls:
+    """The material's two faces on the grid φ (n) × stations t (m): a groove's walls or a rib's faces.
+
+    For a groove this is :func:`barrel_walls`. For a rib, ``upper`` is the
+    rib's +z face and ``lower`` its −z face (:func:`face_rollers`), normals
+    out of the rib towards the roller that runs on it; ``axis`` is the
+    follower's pitch path (between the rollers) and ``pressure_angle`` at
+    each point the larger in magnitude of the two rollers' (equal for a
+    translating follower).
+    """
+    (up_f, up_side), (low_f, low_side) = face_rollers(follower, options)
+    if up_f is follower:
+        return barrel_walls(motion, follower, options, station)
+    up = barrel_walls(motion, up_f, options, station)
+    low = barrel_walls(motion, low_f, options, station)
+    alpha = np.where(
+        np.abs(up.pressure_angle) >= np.abs(low.pressure_angle), up.pressure_angle, low.pressure_angle
+    )
+    readonly(alpha)
+    axis = follower.centre(motion).m0
+    readonly(axis)
+    return BarrelWalls(
+        phi=up.phi,
+        station=up.station,
+        axis=axis,
+        upper=_side_sheet(up, up_side),
+        lower=_side_sheet(low, low_side),
+        pressure_angle=alpha,
+    )
+
+
+def faces_at_radius(
+    motion: Motion, follower: BarrelFollower, options: BarrelOptions, radius: float, side: WallSide
+) -> tuple[FloatArray, WallSheet]:
+    """The ``side`` face cut by the cylinder of ``radius`` [mm]: its roller's :func:`walls_at_radius`."""
+    source = face_rollers(follower, options)[0 if side is WallSide.UPPER else 1]
+    return walls_at_radius(motion, source[0], options, radius, source[1])
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Slip:
     """Sliding of the roller on one wall, per radian of barrel turn [mm/rad] (× ω [rad/s] for mm/s).
@@ -452,9 +591,13 @@ def check_barrel(options: BarrelOptions, follower: BarrelFollower) -> None:
         ``follower.roller_length`` (not shorter than the groove is deep),
         ``follower.roller`` (a cone on an arm), ``follower.arm_length`` (an arm
         shorter than its pivot's distance from the barrel's axis cannot bring
-        the roller over it).
+        the roller over it), ``cam.rib_width`` (a rib's width ≤ 0).
     """
     o = options
+    if isinstance(follower, RibRoller):
+        follower = follower.follower
+    if o.kind is BarrelKind.RIB and not (math.isfinite(o.rib_width) and o.rib_width > 0.0):
+        raise DesignError("cam.rib_width", f"{o.rib_width!r} mm is not allowed; give a rib width > 0 mm")
     for path, value in (
         ("cam.barrel_radius", o.barrel_radius),
         ("cam.length", o.length),

@@ -19,9 +19,10 @@ with radius < r, the lower where it bends towards −z.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import DesignError
@@ -29,12 +30,15 @@ from camcad.extremes import Extreme, Kind, Side, extremes_rows
 from camcad.findings import Finding, Severity
 from camcad.geometry.barrel import (
     BarrelFollower,
+    BarrelKind,
     BarrelOptions,
+    FaceSource,
     WallSide,
     _contact,
     _pressure,
     check_barrel,
-    walls_at_radius,
+    face_rollers,
+    faces_at_radius,
 )
 from camcad.geometry.curves import CurveSample, curve_sample
 from camcad.geometry.envelope import PointElement, offset_curve, translation_envelope
@@ -104,18 +108,24 @@ class BarrelLimits:
     """A barrel cam's figures over the turn, at true extremes (one-sided at joints).
 
     ``pressure_angle_max``: the largest |α| [rad] at the groove's bottom, the
-    pitch station and the top (stations R − depth, t_p, R), in that order;
-    ``stretch_min``: the smallest λ of the (upper, lower) wall at the
-    pitch station and at the bottom, ``{"pitch": (upper, lower), "bottom": (...)}``
-    (≤ 0: the wall loops); ``z_range``: the lowest point of the lower wall
-    and the highest of the upper wall, on the barrel's surface (radius R) [mm];
-    ``findings``: a hard finding for a wall that loops.
+    pitch station and the top (stations R − depth, t_p, R), in that order
+    (a rib: the larger of its two rollers'); ``stretch_min``: the smallest λ
+    of the (upper, lower) face at the pitch station and at the bottom,
+    ``{"pitch": (upper, lower), "bottom": (...)}`` (≤ 0: the face loops);
+    ``z_range``: the lowest point of the lower face and the highest of the
+    upper face [mm] (a groove's on the barrel's surface, a rib's over its
+    height); ``rib_thickness_min``: a rib's least width between its
+    developed faces at the bottom and the top stations [mm],
+    ``{"bottom": ..., "top": ...}`` (negative where the faces cross; empty
+    for a groove); ``findings``: a hard finding for a face that loops or a
+    rib that vanishes.
     """
 
     pressure_angle_max: tuple[Extreme, Extreme, Extreme]
     stretch_min: dict[str, tuple[Extreme, Extreme]]
     z_range: tuple[Extreme, Extreme]
     findings: tuple[Finding, ...]
+    rib_thickness_min: dict[str, Extreme] = field(default_factory=dict)
 
 
 def _axis_rows(motion: Motion, follower: BarrelFollower, bottom: float) -> tuple[FloatArray, FloatArray]:
@@ -124,6 +134,61 @@ def _axis_rows(motion: Motion, follower: BarrelFollower, bottom: float) -> tuple
     out_y: FloatArray = np.abs(axis.m0[:, 0])
     out_u: FloatArray = bottom + axis.m1[:, 0]
     return out_y, out_u
+
+
+def _face_curve(motion: Motion, source: FaceSource, options: BarrelOptions, station: float) -> CurveSample:
+    walls = developed_walls(motion, source[0], options, station)
+    return walls.upper if source[1] is WallSide.UPPER else walls.lower
+
+
+class _RibWidth:
+    """The signed distance from the rib's upper face at φ to its lower face, in the developed plane at t.
+
+    For each U(φ) the foot L(φ′) on the lower face is found from a k-d tree
+    of the lower face sampled every 0.05° and polished by Newton's method on
+    g(φ′) = (L − U)·L′ = 0, g′ = |L′|² + (L − U)·L″ (the exact developed
+    derivatives); the sign is that of (U − L)·n_U, n_U the upper face's
+    normal out of the rib: negative where the faces cross.
+    """
+
+    def __init__(
+        self,
+        program: MotionProgram,
+        faces: tuple[FaceSource, FaceSource],
+        options: BarrelOptions,
+        station: float,
+    ) -> None:
+        self.program, self.faces, self.options, self.station = program, faces, options, station
+        self.phi = np.linspace(0.0, math.tau, 7201)
+        lower = _face_curve(program.evaluate(self.phi), faces[1], options, station).point
+        self.period = math.tau * station
+        shift = np.array([self.period, 0.0])
+        self.tree = cKDTree(np.vstack((lower - shift, lower, lower + shift)))
+
+    def __call__(self, motion: Motion) -> FloatArray:
+        upper = _face_curve(motion, self.faces[0], self.options, self.station)
+        _, idx = self.tree.query(upper.point)
+        n = self.phi.size
+        shift = (idx // n - 1).astype(float)  # which copy: −1, 0, +1 periods
+        foot = self.phi[idx % n] + shift * math.tau
+        for _ in range(8):
+            lower = _face_curve(
+                self.program.evaluate(np.mod(foot, math.tau)), self.faces[1], self.options, self.station
+            )
+            point = lower.point + np.column_stack((np.floor(foot / math.tau) * self.period, 0.0 * foot))
+            diff = point - upper.point
+            g = np.sum(diff * lower.d1, axis=1)
+            dg = np.sum(lower.d1 * lower.d1, axis=1) + np.sum(diff * lower.d2, axis=1)
+            foot = foot - g / dg
+        lower = _face_curve(
+            self.program.evaluate(np.mod(foot, math.tau)), self.faces[1], self.options, self.station
+        )
+        point = lower.point + np.column_stack((np.floor(foot / math.tau) * self.period, 0.0 * foot))
+        gap = upper.point - point
+        # the upper face is its roller's lower wall: its developed normal (towards +w) points out of the rib
+        sign = np.sign(np.sum(gap * upper.normal, axis=1))
+        out: FloatArray = sign * np.hypot(gap[:, 0], gap[:, 1])
+        return out
 
 
 def barrel_limits(
@@ -139,46 +204,56 @@ def barrel_limits(
     ------
     DesignError
         What :func:`~camcad.geometry.barrel.check_barrel` refuses; and, from
-        the motion: the groove crosses the barrel's end z = 0 or z = length
-        (``follower.axial_position``), the arm swings the roller's axis out of
-        the groove's bottom cylinder (``follower.pivot_distance``), or the
-        developed groove runs backwards and crosses itself
+        the motion: the groove (or rib) crosses the barrel's end z = 0 or
+        z = length (``follower.axial_position``), the arm swings a roller's
+        axis out of the groove's bottom cylinder (``follower.pivot_distance``),
+        or the developed groove runs backwards and crosses itself
         (``follower.arm_length``).
     """
     check_barrel(options, follower)
     bottom, tp, top = options.bottom_radius, options.pitch_station, options.barrel_radius
     stations = np.array([bottom, tp, top])
     k = options.taper
+    faces = face_rollers(follower, options)
+    rollers = [faces[0][0]] if faces[0][0] is faces[1][0] else [faces[0][0], faces[1][0]]
+    rib = options.kind is BarrelKind.RIB
+    widths = (
+        {name: _RibWidth(program, faces, options, t) for name, t in (("bottom", bottom), ("top", top))}
+        if rib
+        else {}
+    )
 
     def rows(phi: FloatArray, side: Side) -> FloatArray:
         m = program.evaluate(phi, side=side)
-        axis = follower.centre(m)
-        up = _contact(axis, stations, options, WallSide.UPPER, clearance=True)
-        alpha = np.abs(_pressure(up, follower.driven(m), k))
-        pitch_walls = developed_walls(m, follower, options, tp)
-        bottom_walls = developed_walls(m, follower, options, bottom)
-        # the walls' edges on the barrel's surface (each wall reaches farthest from the pitch line there)
-        z_low = walls_at_radius(m, follower, options, top, WallSide.LOWER)[1].point[:, 0, 2]
-        z_high = walls_at_radius(m, follower, options, top, WallSide.UPPER)[1].point[:, 0, 2]
-        off, advance = _axis_rows(m, follower, bottom)
-        return np.vstack(
-            (
-                alpha.T,
-                pitch_walls.stretch_upper,
-                pitch_walls.stretch_lower,
-                bottom_walls.stretch_upper,
-                bottom_walls.stretch_lower,
-                z_low,
-                z_high,
-                off,
-                advance,
-            )
+        alpha = np.zeros((phi.size, 3))
+        off = np.zeros(phi.size)
+        advance = np.full(phi.size, np.inf)
+        for roller in rollers:
+            up = _contact(roller.centre(m), stations, options, WallSide.UPPER, clearance=True)
+            alpha = np.maximum(alpha, np.abs(_pressure(up, roller.driven(m), k)))
+            o, a = _axis_rows(m, roller, bottom)
+            off, advance = np.maximum(off, o), np.minimum(advance, a)
+        stretch = [_face_curve(m, src, options, t).d1[:, 0] / t for t in (tp, bottom) for src in faces]
+        # a groove's walls reach farthest from the pitch line at the barrel's surface, a rib's at its root
+        radii = (top, bottom) if rib else (top,)
+        z_low = np.min(
+            [faces_at_radius(m, follower, options, r, WallSide.LOWER)[1].point[:, 0, 2] for r in radii],
+            axis=0,
         )
+        z_high = np.max(
+            [faces_at_radius(m, follower, options, r, WallSide.UPPER)[1].point[:, 0, 2] for r in radii],
+            axis=0,
+        )
+        extra = [widths["bottom"](m), widths["top"](m)] if rib else []
+        return np.vstack((alpha.T, *stretch, z_low, z_high, off, advance, *extra))
 
     kinds: tuple[Kind, ...] = ("max", "max", "max", "min", "min", "min", "min", "min", "max", "max", "min")
+    if rib:
+        kinds = (*kinds, "min", "min")
     joints = [bp.phi for bp in program.breakpoints]
     found = extremes_rows(rows, program.sample_phi(step), joints, kinds)
-    a_bot, a_pitch, a_top, sp_u, sp_l, sb_u, sb_l, z_low, z_high, off, advance = found
+    a_bot, a_pitch, a_top, sp_u, sp_l, sb_u, sb_l, z_low, z_high, off, advance = found[:11]
+    thickness = dict(zip(("bottom", "top"), found[11:], strict=True)) if rib else {}
     if off.value >= bottom:
         raise DesignError(
             "follower.pivot_distance",
@@ -194,20 +269,22 @@ def barrel_limits(
         )
     if z_low.value < 0.0 or z_high.value > options.length:
         bad = z_low if z_low.value < 0.0 else z_high
+        what = "rib" if rib else "groove"
         raise DesignError(
             "follower.axial_position",
-            f"the groove reaches z = {bad.value:.3f} mm {bad.where()}, beyond the barrel's ends "
+            f"the {what} reaches z = {bad.value:.3f} mm {bad.where()}, beyond the barrel's ends "
             f"0 … {options.length:g} mm; move axial_position or lengthen the barrel",
         )
+    what = "rib's" if rib else "groove's"
     findings = [
         Finding(
             kind="groove undercut",
             severity=Severity.HARD,
             field="cam.barrel_radius",
             message=(
-                f"cam.barrel_radius: the groove's {name} wall loops at the {where} (station {t:g} mm) "
-                f"{ext.where()}: the developed pitch line bends more sharply than the roller; use a larger "
-                "barrel, a smaller roller, a shallower groove or a gentler law"
+                f"cam.barrel_radius: the {what} {name} {'face' if rib else 'wall'} loops at the {where} "
+                f"(station {t:g} mm) {ext.where()}: the developed pitch line bends more sharply than the "
+                "roller; use a larger barrel, a smaller roller, a shallower groove or a gentler law"
             ),
             angle=ext.phi,
             value=ext.value,
@@ -220,9 +297,28 @@ def barrel_limits(
         )
         if ext.value <= 0.0
     ]
+    findings += [
+        Finding(
+            kind="rib vanishes",
+            severity=Severity.HARD,
+            field="cam.rib_width",
+            message=(
+                f"cam.rib_width: the rib's faces cross at its {name} (station {t:g} mm) {ext.where()}, "
+                f"where its least width is {ext.value:.3f} mm: a steep flank narrows the rib; "
+                "use a wider rib, a gentler law or a larger barrel"
+            ),
+            angle=ext.phi,
+            value=ext.value,
+            limit=0.0,
+            unit="mm",
+        )
+        for name, t in (("bottom", bottom), ("top", top))
+        if name in thickness and (ext := thickness[name]).value <= 0.0
+    ]
     return BarrelLimits(
         pressure_angle_max=(a_bot, a_pitch, a_top),
         stretch_min={"pitch": (sp_u, sp_l), "bottom": (sb_u, sb_l)},
         z_range=(z_low, z_high),
         findings=tuple(findings),
+        rib_thickness_min=thickness,
     )

@@ -223,3 +223,125 @@ def test_developed_dxf_holds_both_walls(name, tmp_path):
     # the walls are the roller's width apart across the pitch line
     gap = np.linalg.norm(exact.upper.point - exact.lower.point, axis=1)
     assert gap == pytest.approx(2 * c.options.roller_radius + c.options.clearance, abs=1e-9)
+
+
+# -- a rib -------------------------------------------------------------------------------
+
+
+@cache
+def rib_fit() -> BarrelWallFit:
+    from tests.barrel_cases import RIB
+
+    return fit_barrel_walls(RIB.program, RIB.follower, RIB.options)
+
+
+def test_rib_step_is_one_valid_solid_with_the_quadratures_volume_and_exact_faces():
+    """The rib's STEP solid: BRepCheck valid, one solid, its faces' nodes on the exact faces, its volume.
+
+    The volume's truth is the core (less the bore) plus the quadrature of the rib between its exact
+    faces on cylinders (tests/barrel_cases.py), independent of the fit and of OpenCASCADE.
+    """
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    from camcad.export.barrel_step import barrel_shape, barrel_step_bytes
+    from camcad.geometry.barrel import barrel_faces
+    from tests.barrel_cases import RIB
+
+    fit = rib_fit()
+    assert fit.max_error <= fit.tolerance
+    s = barrel_shape(fit, RIB.options)
+    assert BRepCheck_Analyzer(s.shape).IsValid()
+    assert s.volume == pytest.approx(barrel_volume(RIB), abs=0.05)
+    o = RIB.options
+    blank = math.pi * (o.barrel_radius**2 - (0.5 * o.bore) ** 2) * o.length
+    core = math.pi * (o.bottom_radius**2 - (0.5 * o.bore) ** 2) * o.length
+    assert core + 1000.0 < s.volume < blank - 1000.0  # a rib, not a groove nor a bare core
+    faces = _wall_nodes(s.shape)
+    assert len(faces) >= 2
+    t0, t1 = fit.upper.station_range
+    worst, radii = 0.0, []
+    for xyz, uv in faces:
+        phi, t = 2.0 * math.pi * uv[:, 0], t0 + uv[:, 1] * (t1 - t0)
+        exact = barrel_faces(RIB.program.evaluate(phi), RIB.follower, o, t[:, None])
+        up = np.linalg.norm(exact.upper.point[:, 0] - xyz, axis=1)
+        low = np.linalg.norm(exact.lower.point[:, 0] - xyz, axis=1)
+        worst = max(worst, float(np.minimum(up, low).max()))
+        radii.append(np.hypot(xyz[:, 0], xyz[:, 1]))
+    rho = np.concatenate(radii)
+    assert rho.min() < o.bottom_radius + 0.5 and rho.max() > o.barrel_radius - 0.5
+    assert rho.min() > o.bottom_radius - 1e-3 and rho.max() < o.barrel_radius + 1e-3
+    assert worst <= fit.tolerance
+    data = barrel_step_bytes(s, name="rib")
+    assert data == barrel_step_bytes(s, name="rib")  # same input, same bytes
+    text = data.decode("ascii")
+    assert text.count("MANIFOLD_SOLID_BREP") == 1 and text.count("B_SPLINE_SURFACE_WITH_KNOTS") >= 2
+
+
+def test_rib_stl_is_watertight_and_its_volume_within_the_sag(tmp_path):
+    import trimesh
+
+    from camcad.export.barrel_mesh import BarrelMeshOptions, barrel_mesh, barrel_stl_bytes
+    from tests.barrel_cases import RIB
+
+    opts = BarrelMeshOptions()
+    mesh = barrel_mesh(RIB.program, RIB.follower, RIB.options, opts)
+    path = tmp_path / "cam.stl"
+    path.write_bytes(barrel_stl_bytes(mesh))
+    tm = trimesh.load(path, process=True)
+    assert tm.is_watertight and tm.is_winding_consistent
+    assert len(tm.split(only_watertight=False)) == 1
+    assert abs(tm.volume - barrel_volume(RIB)) <= tm.area * opts.chord
+    rho = np.hypot(tm.vertices[:, 0], tm.vertices[:, 1])
+    assert rho.max() == pytest.approx(RIB.options.barrel_radius, abs=1e-3)
+
+
+def test_rib_developed_dxf_holds_both_faces(tmp_path):
+    """The SPLINEs against the developed faces, and the faces against their rollers' shifted pitch lines."""
+    import ezdxf
+
+    from camcad.export.barrel_dxf import developed_groove, write_developed_dxf
+    from tests.barrel_cases import RIB
+
+    o = RIB.options
+    groove = developed_groove(RIB.program, RIB.follower, o, tolerance=0.005)
+    path = tmp_path / "profile.dxf"
+    write_developed_dxf(groove, path, length=o.length)
+    doc = ezdxf.readfile(path)
+    tp, h, r_w = o.pitch_station, o.rib_offset, o.roller_radius + 0.5 * o.clearance
+    z0 = RIB.follower.axial_position
+    for layer, sign in (("WALL_UPPER", 1.0), ("WALL_LOWER", -1.0), ("PITCH", 0.0)):
+        # vertices 0.015 mm apart: the nearest is within (0.0075 mm)²/(2·8 mm) of a curve 8 mm away; 20×
+        # denser on the pitch line itself, where it is within half the spacing
+        phi = np.linspace(-0.2, 2.0 * math.pi + 0.2, 30001 if sign else 600001)
+        s = RIB.program.evaluate(np.mod(phi, 2.0 * math.pi)).s
+        (spline,) = doc.modelspace().query(f'SPLINE[layer=="{layer}"]')
+        pts = np.array([(p.x, p.y) for p in spline.construction_tool().approximate(20000)])
+        # the roller's path unrolled at the pitch station: (t_p φ, z0 ± h + s)
+        path_pts = np.column_stack((tp * phi, z0 + sign * h + s))
+        d, idx = cKDTree(path_pts).query(pts)
+        assert np.abs(d - (r_w if sign else 0.0)).max() <= 0.005 + 0.002
+        if sign:
+            assert np.all(sign * (pts[:, 1] - path_pts[idx, 1]) < 0.0)  # on the rib's side of the roller
+
+
+@pytest.mark.parametrize("variant", ["arm", "cone"])
+def test_an_arm_rib_and_a_conical_rib_are_valid_with_the_quadratures_volume(variant):
+    """A rib on an arm's yoke and a rib between conical rollers: BRepCheck valid, the quadrature's volume."""
+    from dataclasses import replace
+
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    from camcad.export.barrel_step import barrel_shape
+    from camcad.geometry.barrel import BarrelKind, RollerShape
+    from tests.barrel_cases import ARM, RIB
+
+    if variant == "arm":
+        o = replace(ARM.options, kind=BarrelKind.RIB, rib_width=12.0, depth=15.0, roller_length=12.0)
+        case = replace(ARM, name="arm-rib", options=o)
+    else:
+        case = replace(RIB, name="cone-rib", options=replace(RIB.options, roller=RollerShape.CONICAL))
+    fit = fit_barrel_walls(case.program, case.follower, case.options)
+    assert fit.max_error <= fit.tolerance
+    s = barrel_shape(fit, case.options)
+    assert BRepCheck_Analyzer(s.shape).IsValid()
+    assert s.volume == pytest.approx(barrel_volume(case), abs=0.05)

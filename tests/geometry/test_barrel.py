@@ -28,13 +28,16 @@ from scipy.spatial import cKDTree
 
 from camcad.errors import EXIT_INVALID, DesignError, exit_code
 from camcad.geometry.barrel import (
+    BarrelKind,
     BarrelOptions,
     OscillatingBarrelRoller,
     RollerShape,
     TranslatingBarrelRoller,
     WallSide,
+    barrel_faces,
     barrel_walls,
     check_barrel,
+    rib_rollers,
     roller_slip,
     walls_at_radius,
 )
@@ -507,3 +510,178 @@ def test_laws_and_lifts(law, lift, span, t):
     dev = developed_walls(m, TRANSLATING, opt, t)
     assert_allclose(dev.upper.point - dev.pitch.point, r_w * dev.pitch.normal, atol=1e-10)
     assert_allclose(np.abs(walls.pressure_angle[:, 0]), np.arccos(np.abs(dev.pitch.normal[:, 1])), atol=1e-7)
+
+
+# -- a rib instead of a groove ---------------------------------------------------------
+
+
+def rib_options(**kw: object) -> BarrelOptions:
+    base: dict[str, object] = {
+        "kind": BarrelKind.RIB,
+        "rib_width": 14.0,
+        "depth": 15.0,
+        "roller_length": 12.0,
+    }
+    return options(**{**base, **kw})
+
+
+def _yoke_centre(follower: OscillatingBarrelRoller, offset: float, psi_rad: np.ndarray) -> np.ndarray:
+    """(y, z) of a rib roller on a yoke: its ψ = 0 place, h along the arm's perpendicular, turned by −ψ."""
+    d, arm, z0 = follower.pivot_distance, follower.arm_length, follower.axial_position
+    pivot = np.array([d, z0 - math.sqrt(arm * arm - d * d)])
+    arm0 = np.array([0.0, z0]) - pivot
+    across = np.array([arm0[1], -arm0[0]]) / arm  # the arm's perpendicular, on the side a rise moves it
+    start = arm0 + offset * across
+    out = []
+    for ang in -psi_rad:
+        c, s = math.cos(ang), math.sin(ang)
+        out.append(pivot + np.array([c * start[0] - s * start[1], s * start[0] + c * start[1]]))
+    return np.array(out)
+
+
+def test_rib_rollers_on_a_yoke_against_a_rotation():
+    prog = arm_program()
+    m = prog.evaluate(PHI)
+    for roller, sign in zip(rib_rollers(ARM, rib_options()), (1.0, -1.0), strict=True):
+        h = rib_options().rib_offset
+        assert roller.offset == sign * h == sign * (7.0 + 8.0 + 0.05)
+        assert_allclose(roller.centre(m).m0, _yoke_centre(ARM, roller.offset, np.radians(m.s)), atol=1e-10)
+        eps = 1e-6
+        moved = _yoke_centre(ARM, roller.offset, np.radians(m.s) + eps) - _yoke_centre(
+            ARM, roller.offset, np.radians(m.s) - eps
+        )
+        assert_allclose(roller.driven(m), moved / np.linalg.norm(moved, axis=1)[:, None], atol=1e-7)
+
+
+@pytest.mark.parametrize(
+    ("follower", "shape", "prog"),
+    [
+        (TRANSLATING, RollerShape.CYLINDRICAL, program(30.0)),
+        (TRANSLATING, RollerShape.CONICAL, program(30.0)),
+        (ARM, RollerShape.CYLINDRICAL, arm_program()),
+    ],
+    ids=["translating-cylinder", "translating-cone", "arm-cylinder"],
+)
+def test_rib_faces_touch_their_roller_and_neither_roller_cuts_the_rib(follower, shape, prog):
+    """Brute force in 3-D: each face point touches its own roller at φ and is outside both at every φ′."""
+    opt = rib_options(roller=shape)
+    phis = PHI[::24]
+    st = np.array([55.0, 64.0, 70.0])
+    faces = barrel_faces(prog.evaluate(phis), follower, opt, st)
+    up_roller, low_roller = rib_rollers(follower, opt)
+    scan = np.linspace(-0.4, 0.4, 801)
+    for sheet, own in ((faces.upper, up_roller), (faces.lower, low_roller)):
+        for i, phi in enumerate(phis):
+            for j in range(st.size):
+                p = sheet.point[i, j]
+                assert abs(_outside(p, own, prog, np.array([phi]), opt)[0]) < 1e-9
+                for roller in (up_roller, low_roller):
+                    assert _outside(p, roller, prog, phi + scan, opt).min() > -1e-4
+        # normals out of the rib: towards its roller's axis, away from the pitch path between the rollers
+        m = prog.evaluate(phis)
+        e_r = np.stack((np.cos(phis), np.sin(phis), 0 * phis), axis=-1)[:, None, :]
+        e_t = np.stack((-np.sin(phis), np.cos(phis), 0 * phis), axis=-1)[:, None, :]
+        yz = own.centre(m).m0
+        axis_pt = (
+            st[None, :, None] * e_r + yz[:, None, 0:1] * e_t + yz[:, None, 1:2] * np.array([0.0, 0.0, 1.0])
+        )
+        assert np.all(np.sum(sheet.normal * (axis_pt - sheet.point), axis=-1) > 0.0)
+
+
+def test_rib_faces_at_pitch_are_the_plate_envelopes_of_the_shifted_pitch_lines():
+    """Second method: each developed face lies r_w from a dense polyline of its roller's unrolled path.
+
+    The roller paths are (t_p·φ, z0 ± h + s(φ)); the upper face lies below the upper path, the lower
+    face above the lower one, and where the follower dwells the faces are the rib's width apart.
+    """
+    prog = program(30.0)
+    opt = rib_options()
+    tp, h = opt.pitch_station, opt.rib_offset
+    r_w = opt.roller_radius + 0.5 * opt.clearance
+    dense = np.linspace(-0.5, 2 * math.pi + 0.5, 400_001)
+    s_dense = prog.evaluate(dense).s
+    m = prog.evaluate(PHI)
+    walls = barrel_faces(m, TRANSLATING, opt, np.array([tp]))
+    e_t = np.column_stack((-np.sin(PHI), np.cos(PHI)))
+    developed = {}
+    for sheet, sign, name in ((walls.upper, 1.0, "upper"), (walls.lower, -1.0, "lower")):
+        u = tp * PHI + np.sum(sheet.point[:, 0, :2] * e_t, axis=1)
+        w = sheet.point[:, 0, 2]
+        path = np.column_stack((tp * dense, 35.0 + sign * h + s_dense))
+        dist, idx = cKDTree(path).query(np.column_stack((u, w)))
+        assert_allclose(dist, r_w, atol=1e-6)
+        assert np.all(sign * (w - path[idx, 1]) < 0.0)  # towards the rib
+        developed[name] = np.column_stack((u, w))
+    dwell = np.abs(m.v) < 1e-12
+    assert dwell.sum() > 50
+    width = developed["upper"][dwell, 1] - developed["lower"][dwell, 1]
+    assert_allclose(width, opt.rib_width, atol=1e-12)
+    assert_allclose(developed["upper"][dwell, 0], developed["lower"][dwell, 0], atol=1e-12)
+
+
+def test_rib_limits_against_brute_force():
+    """z reach, pressure angle and the rib's least width against dense samples and a k-d tree."""
+    prog = program(30.0)
+    opt = rib_options()
+    lim = barrel_limits(prog, TRANSLATING, opt)
+    assert not lim.findings
+    h, r_w = opt.rib_offset, 8.05
+    # each face reaches farthest from the pitch line where the follower dwells: z0 ± (h − r_w) = z0 ± w/2
+    assert h - r_w == pytest.approx(7.0, abs=1e-12)
+    assert lim.z_range[0].value == pytest.approx(35.0 - (h - r_w), abs=1e-9)
+    assert lim.z_range[1].value == pytest.approx(65.0 + (h - r_w), abs=1e-9)
+    v_max = 2.0 * 30.0 / (math.pi / 2.0)  # cycloidal: s′max = 2h/β (Rothbart 2004, §3.4)
+    for ext, r in zip(lim.pressure_angle_max, (55.0, opt.pitch_station, 70.0), strict=True):
+        assert ext.value == pytest.approx(math.atan(v_max / r), abs=1e-10)
+    # the nearest vertex of a polyline 0.02 mm apart is within (0.01 mm)²/(2·10 mm) = 5e-6 mm of the curve's
+    dense = np.linspace(0.0, 2 * math.pi, 20_001)
+    m = prog.evaluate(dense)
+    for name, t in (("bottom", 55.0), ("top", 70.0)):
+        up_roller, low_roller = rib_rollers(TRANSLATING, opt)
+        upper = developed_walls(m, up_roller, opt, t).lower.point
+        lower = developed_walls(m, low_roller, opt, t).upper.point
+        period = np.array([2 * math.pi * t, 0.0])
+        d, _ = cKDTree(np.vstack((lower - period, lower, lower + period))).query(upper)
+        assert lim.rib_thickness_min[name].value == pytest.approx(d.min(), abs=2e-5)
+        assert lim.rib_thickness_min[name].value < opt.rib_width - 1.0  # the flank is narrower than the dwell
+    assert lim.rib_thickness_min["bottom"].value < lim.rib_thickness_min["top"].value
+
+
+def test_a_rib_too_narrow_for_its_flank_vanishes():
+    lim = barrel_limits(program(50.0, span_deg=60.0), TRANSLATING, rib_options(rib_width=1.0, length=140.0))
+    (finding,) = [f for f in lim.findings if f.kind == "rib vanishes"][:1]
+    assert finding.field == "cam.rib_width"
+    assert lim.rib_thickness_min["bottom"].value < 0.0
+    with pytest.raises(DesignError) as err:
+        check_barrel(rib_options(rib_width=0.0), TRANSLATING)
+    assert err.value.path == "cam.rib_width"
+    assert exit_code(err.value) == EXIT_INVALID
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    law=st.sampled_from(["cycloidal", "poly-345", "harmonic", "modified-sine"]),
+    lift=st.floats(2.0, 40.0),
+    span=st.floats(60.0, 170.0),
+    width=st.floats(4.0, 30.0),
+    t=st.floats(55.0, 70.0),
+)
+def test_rib_faces_for_any_law(law, lift, span, width, t):
+    """Any translating rib: each developed face is r_w from its roller's path, on the rib's side, and
+    the faces are the rib's width apart (exactly, along z) wherever the follower dwells."""
+    prog = program(lift, law=law, span_deg=span)
+    m = prog.evaluate(PHI)
+    opt = rib_options(rib_width=width)
+    h, r_w = opt.rib_offset, opt.roller_radius + 0.5 * opt.clearance
+    up_roller, low_roller = rib_rollers(TRANSLATING, opt)
+    upper = developed_walls(m, up_roller, opt, t).lower
+    lower = developed_walls(m, low_roller, opt, t).upper
+    for face, sign in ((upper, 1.0), (lower, -1.0)):
+        path = np.column_stack((t * PHI, 35.0 + sign * h + m.s))
+        offset = face.point - path
+        assert_allclose(np.hypot(offset[:, 0], offset[:, 1]), r_w, atol=1e-10)
+        # along the path's normal (−s′, t)/D, towards the rib
+        normal = np.column_stack((-m.v, np.full_like(m.v, t))) / np.hypot(m.v, t)[:, None]
+        assert_allclose(np.sum(offset * normal, axis=1), -sign * r_w, atol=1e-10)
+    dwell = np.abs(m.v) < 1e-12
+    assert_allclose(upper.point[dwell, 1] - lower.point[dwell, 1], width, atol=1e-10)

@@ -41,13 +41,26 @@ def render_barrel_program(toolpath: BarrelToolpath, *, name: str = "barrel cam")
         "A turns the barrel about +X; at A0 the barrel's x axis points to +Z; the tool points down -Z",
         "Z = distance of the tool tip from the barrel axis; Y = offset of the tool axis from it",
         f"rough: T{s.rough_tool} flat end mill D{2 * toolpath.passes[0].radius:.3f}, stock {s.stock:.3f}",
-        f"finish: T{s.finish_tool} flat end mill D{2 * o.roller_radius:.3f} (the roller's diameter) "
-        "along the roller's own path, one pass per wall",
         f"tolerance: {s.tolerance:.4f}, measured path deviation {toolpath.max_deviation:.4f}",
-        f"a wall finished with T{s.rough_tool} instead (exact at the pitch station) would be off by up to "
-        f"{float(abs(toolpath.small_cutter[0]).max()):.4f} at the groove's bottom and "
-        f"{float(abs(toolpath.small_cutter[1]).max()):.4f} at its top",
     ]
+    finish = toolpath.passes[-1]
+    if finish.taper > 0.0:
+        head[-1:-1] = [
+            f"finish: T{s.finish_tool} tapered end mill, tip D{2 * finish.radius:.4f} at Z{finish.z:.4f}, "
+            f"flank half-angle {math.degrees(math.atan(finish.taper)):.4f} deg",
+            f"radius grows {finish.taper:.6f}/mm up the tool: the conical roller's taper (apex on the axis)",
+            "the tapered cutter follows the roller's own path: one pass cuts both walls",
+        ]
+    else:
+        head[-1:-1] = [
+            f"finish: T{s.finish_tool} flat end mill D{2 * o.roller_radius:.3f} (the roller's diameter) "
+            "along the roller's own path, one pass per wall",
+        ]
+        head.append(
+            f"a wall finished with T{s.rough_tool} instead (exact at the pitch station) would be off by "
+            f"up to {float(abs(toolpath.small_cutter[0]).max()):.4f} at the groove's bottom and "
+            f"{float(abs(toolpath.small_cutter[1]).max()):.4f} at its top"
+        )
     out = [f"({comment_text(t)})" for t in head]
     out += ["G21 G90 G17 G40 G49 G94 G64 P" + _n(s.tolerance)]
     tool = None
