@@ -65,8 +65,7 @@ from camcad.geometry.followers import (
 from camcad.geometry.followers.base import KeyRange
 from camcad.geometry.sensitivity import Tol
 from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, Rotation
-from camcad.motion._blendlaws import MAX_POLYNOMIAL_DEGREE
-from camcad.motion.laws import DUDLEY_MAX_DEGREE, LAWS
+from camcad.motion.laws import DUDLEY_MAX_DEGREE, LAWS, MAX_POLYNOMIAL_DEGREE
 from camcad.motion.segments import SegmentKind
 from camcad.toolpath.spec import Cutter, Machine, RotaryAxis
 
