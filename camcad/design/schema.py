@@ -16,6 +16,13 @@ analyses and builds in seconds: physical sizes up to a 10 m part
 and table steps, chord and fit tolerances, passes, tabs, helix turns) no finer
 than the outputs can use. Every text the user gives is sanitised where it is
 written (G-code comments, DXF text, HTML, plot labels), not here.
+
+This module is the entry; the loader's parts live beside it, one reason to
+change each: :mod:`~camcad.design.rules` (a key's rule, its check, the
+converters and the bounds), :mod:`~camcad.design.tables` (the rule table),
+:mod:`~camcad.design.motion` (the ``[[motion]]`` tables),
+:mod:`~camcad.design.checks` (the checks across fields) and
+:mod:`~camcad.design.toml_where` (where in the text an unreadable value sits).
 """
 
 from __future__ import annotations
