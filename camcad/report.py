@@ -4,8 +4,11 @@
 HTML page that opens offline: warnings first, the key numbers at a glance,
 the figures (PNG, embedded as base64 ``data:`` URIs) and the full tables of
 ``summary.json``. :func:`render_compare` overlays several designs and tabulates
-them as in Quintero & Vanegas (2016), section 5. Every piece of text is
-escaped with :func:`html.escape`; the page has no external references.
+them as in Quintero & Vanegas (2016), section 5. This module gathers what a
+page shows; the Jinja2 templates in ``camcad/templates`` (package data, with the
+style sheet ``report.css``) lay it out. Autoescape is on: every value a
+template writes is escaped (:func:`_e`) unless it is markup the templates
+made; the page has no external references.
 
 References
 ----------
@@ -16,13 +19,17 @@ References
 from __future__ import annotations
 
 import base64
+import functools
 import html
 import math
 from collections.abc import Callable, Mapping, Sequence
+from importlib.resources import files
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import jinja2
 import numpy as np
+from markupsafe import Markup
 
 from camcad._plots import Plot, compare_plots, report_plots
 from camcad._plots.compare import compare_colors
@@ -53,100 +60,14 @@ __all__ = [
 ]
 
 _DASH = "—"
+_TEMPLATES = files("camcad") / "templates"
 
-CSS = """
-:root { --ink:#1d2733; --muted:#5b6877; --line:#d8dee6; --bg:#f5f7fa; --card:#fff;
-        --warn:#fff4d6; --warn-edge:#e0a800; --bad:#fde2e1; --bad-edge:#c0392b;
-        --ok:#e3f4e8; --ok-edge:#2e8b57; }
-* { box-sizing: border-box; }
-html { -webkit-text-size-adjust: 100%; }
-body { margin:0; font: 14px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, sans-serif;
-       color:var(--ink); background:var(--bg); overflow-wrap: anywhere; }
-main { max-width: 1400px; margin: 0 auto; padding: 20px clamp(10px, 3vw, 24px) 40px; }
-header h1 { margin: 0 0 4px; font-size: clamp(19px, 4vw, 24px); }
-header p { margin: 0; color: var(--muted); }
-h2 { font-size: 18px; margin: 28px 0 10px; border-bottom: 1px solid var(--line); padding-bottom: 4px; }
-h3 { font-size: 15px; margin: 18px 0 6px; }
-.alert { border-left: 5px solid; border-radius: 4px; padding: 10px 14px; margin: 16px 0 0; }
-.alert h2 { border: 0; margin: 0 0 6px; padding: 0; font-size: 16px; }
-.alert ul, .alert p { margin: 0; padding-left: 20px; }
-.alert p { padding-left: 0; }
-.warn { background: var(--warn); border-color: var(--warn-edge); }
-.bad { background: var(--bad); border-color: var(--bad-edge); }
-.ok { background: var(--ok); border-color: var(--ok-edge); }
-.glance { display: grid; grid-template-columns: minmax(0, 5fr) minmax(0, 6fr); gap: 14px; margin-top: 16px;
-          align-items: start; }
-.cards { display: grid; grid-template-columns: repeat(auto-fill, minmax(min(100%, 170px), 1fr)); gap: 10px; }
-.card { background: var(--card); border: 1px solid var(--line); border-radius: 6px; padding: 8px 11px; }
-.card.over { border-color: var(--bad-edge); background: var(--bad); }
-.card .label { color: var(--muted); font-size: 12px; text-transform: uppercase; letter-spacing: .03em; }
-.card .value { font-size: 20px; font-weight: 600; font-variant-numeric: tabular-nums; }
-.card .note { color: var(--muted); font-size: 12px; }
-.plots { display: grid; grid-template-columns: repeat(auto-fit, minmax(min(100%, 460px), 1fr)); gap: 14px; }
-figure { margin: 0; background: var(--card); border: 1px solid var(--line); border-radius: 6px;
-         padding: 10px; min-width: 0; }
-figure img { width: 100%; height: auto; display: block; }
-figure.small img { max-width: 460px; margin: 0 auto; }
-figure.note { background: #f0f3f7; align-self: start; }
-figcaption { color: var(--muted); font-size: 12.5px; margin-top: 6px; }
-figcaption b { color: var(--ink); }
-.scroll { max-width: 100%; overflow-x: auto; }
-table { border-collapse: collapse; background: var(--card); margin: 4px 0 10px;
-        font-variant-numeric: tabular-nums; max-width: 100%; }
-th, td { border: 1px solid var(--line); padding: 4px 8px; text-align: left; vertical-align: top; }
-th { background: #eef2f6; font-weight: 600; }
-td.num { text-align: right; white-space: nowrap; }
-td table { margin: 0; }
-.tables { display: grid; grid-template-columns: repeat(auto-fit, minmax(min(100%, 400px), 1fr));
-          gap: 0 24px; }
-.tables > div { min-width: 0; }
-.wide { grid-column: 1 / -1; }
-.key { list-style: none; padding: 0; margin: 0 0 10px; display: flex; flex-wrap: wrap; gap: 4px 18px; }
-.key .swatch { display: inline-block; width: 22px; height: 0; border-top: 4px solid; vertical-align: middle;
-               margin-right: 6px; }
-footer { margin-top: 30px; color: var(--muted); font-size: 12px; }
-@media (max-width: 900px) {
-  .glance { grid-template-columns: minmax(0, 1fr); }
-}
-@media (max-width: 560px) {
-  body { font-size: 13px; }
-  th, td { padding: 3px 5px; }
-  .card .value { font-size: 18px; }
-}
-@page { size: auto; margin: 12mm 11mm; }
-@media print {
-  body { background: #fff; font-size: 9.5pt; }
-  main { max-width: none; padding: 0; }
-  h2 { margin: 12px 0 6px; font-size: 12pt; break-after: avoid; }
-  .alert { margin-top: 8px; padding: 6px 10px; }
-  .glance { grid-template-columns: minmax(0, 3fr) minmax(0, 2fr); gap: 8px; margin-top: 8px; }
-  .glance figure img { max-height: 92mm; width: auto; max-width: 100%; margin: 0 auto; }
-  .cards { grid-template-columns: repeat(2, minmax(0, 1fr)); gap: 5px; }
-  .card { padding: 4px 7px; }
-  .card .value { font-size: 12pt; }
-  .card .label, .card .note { font-size: 7.5pt; }
-  .plots { display: block; orphans: 1; widows: 1; }  /* a row of figures is one line: break after any */
-  .plots figure { display: inline-block; width: calc(50% - 4px); vertical-align: top; break-inside: avoid;
-                  margin: 0 0 6px; padding: 4px; }
-  .plots figure img { max-height: 56mm; width: auto; max-width: 100%; margin: 0 auto; }
-  figure { border-color: #ccc; }
-  .scroll { overflow: visible; }
-  th, td { overflow-wrap: normal; word-break: normal; hyphens: manual; }
-  .records table { width: auto; max-width: 100%; font-size: 6.5pt; }
-  .records th, .records td { padding: 1px 2px; }
-  .tables { display: block; column-count: 2; column-gap: 6mm; }
-  .tables > .wide { column-span: all; }
-  table { width: 100%; font-size: 8pt; }
-  th, td { padding: 2px 4px; }
-  figure.small img { max-height: 60mm; }
-  tr, figure, .card { break-inside: avoid; }
-  .tables > div { break-inside: avoid; }
-}
-"""
+CSS = (_TEMPLATES / "report.css").read_text(encoding="utf-8")
+"""The report's style sheet (``camcad/templates/report.css``), for screens and print; the designer's too."""
 
 
 # ---------------------------------------------------------------------------
-# small formatting helpers
+# templates and small formatting helpers
 
 
 def _e(text: object) -> str:
@@ -155,6 +76,47 @@ def _e(text: object) -> str:
         "\ufffd" if (ord(c) < 32 and c not in "\t\n\r") or ord(c) == 127 else c for c in str(text)
     )
     return html.escape(plain, quote=True)
+
+
+def _escaped(value: object) -> Markup:
+    """A template value as markup: escaped by :func:`_e`, unless it is markup a template made already."""
+    return value if isinstance(value, Markup) else Markup(_e(value))
+
+
+def _looks_numeric(cell: object) -> bool:
+    """Whether a cell, escaped, is a single number or the dash (it is then right-aligned)."""
+    text = _e(cell)
+    try:
+        float(text.replace("−", "-"))
+    except ValueError:
+        return text == _DASH
+    return True
+
+
+@functools.cache
+def _environment() -> jinja2.Environment:
+    """The templates of ``camcad/templates``, autoescaped.
+
+    Jinja2's own escaping is replaced by :func:`_e` (through ``finalize``,
+    which sees every value before it is written), so that control characters
+    in a user's text become U+FFFD and quotes are written as before.
+    """
+    env = jinja2.Environment(
+        loader=jinja2.PackageLoader("camcad", "templates"),
+        autoescape=True,
+        finalize=_escaped,
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+    )
+    env.tests["numeric_cell"] = _looks_numeric
+    return env
+
+
+def _render(template: str, **values: Any) -> str:
+    """A template of ``camcad/templates`` filled with ``values``."""
+    return _environment().get_template(template).render(**values)
 
 
 def _num(value: Any, spec: str = ".6g") -> str:
@@ -179,66 +141,23 @@ def _peak(values: Any, fn: Callable[[np.ndarray], Any] = np.max) -> float | None
     return float(fn(arr)) if arr.size else None
 
 
-def _img(plot: Plot, *, cls: str = "") -> str:
-    """A figure: the image as a ``data:`` URI (SVG, or PNG), or just its caption for a note."""
-    klass = f' class="{cls}"' if cls else ""
+def _figure(plot: Plot, *, cls: str = "") -> dict[str, Any]:
+    """A figure for the templates: the image as a ``data:`` URI (SVG, or PNG), or none for a note."""
+    src = None
     if plot.svg is not None:
         src = "data:image/svg+xml;base64," + base64.b64encode(plot.svg).decode("ascii")
     elif plot.png is not None:
         src = "data:image/png;base64," + base64.b64encode(plot.png).decode("ascii")
-    else:
-        return (
-            f'<figure id="plot-{_e(plot.key)}" class="note {cls}"><figcaption><b>{_e(plot.title)}.</b> '
-            f"{_e(plot.caption)}</figcaption></figure>"
-        )
-    return (
-        f'<figure id="plot-{_e(plot.key)}"{klass}><img alt="{_e(plot.title)}" src="{src}">'
-        f"<figcaption><b>{_e(plot.title)}.</b> {_e(plot.caption)}</figcaption></figure>"
-    )
-
-
-def _page(title: str, body: str) -> str:
-    return (
-        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
-        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-        f"<title>{_e(title)}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<main>\n"
-        f"{body}\n</main>\n</body>\n</html>\n"
-    )
-
-
-def _looks_numeric(cell: str) -> bool:
-    """Whether an escaped cell is a single number (it is then right-aligned)."""
-    try:
-        float(cell.replace("−", "-"))
-    except ValueError:
-        return cell == _DASH
-    return True
-
-
-def _table(header: Sequence[str] | None, rows: Sequence[Sequence[str]]) -> str:
-    """A table of already escaped cells; numeric cells are right-aligned."""
-    out = ["<table>"]
-    if header is not None:
-        out.append("<tr>" + "".join(f"<th>{h}</th>" for h in header) + "</tr>")
-    for row in rows:
-        cells = [f'<td class="num">{c}</td>' if _looks_numeric(c) else f"<td>{c}</td>" for c in row]
-        out.append("<tr>" + "".join(cells) + "</tr>")
-    out.append("</table>")
-    return "".join(out)
+    return {"key": plot.key, "title": plot.title, "caption": plot.caption, "src": src, "cls": cls}
 
 
 def _is_records(value: Any) -> bool:
     return isinstance(value, (list, tuple)) and bool(value) and all(isinstance(v, Mapping) for v in value)
 
 
-def _alert(kind: str, title: str, items: Sequence[str], *, anchor: str = "") -> str:
+def _alert(kind: str, title: str, items: Sequence[str], *, anchor: str = "") -> dict[str, Any]:
     """A highlighted box: ``kind`` is ``bad``, ``warn`` or ``ok``; ``items`` plain text."""
-    ident = f' id="{_e(anchor)}"' if anchor else ""
-    if kind == "ok":
-        body = "".join(f"<p>{_e(i)}</p>" for i in items)
-    else:
-        body = "<ul>" + "".join(f"<li>{_e(i)}</li>" for i in items) + "</ul>"
-    return f'<section class="alert {kind}"{ident}><h2>{_e(title)}</h2>{body}</section>'
+    return {"kind": kind, "title": title, "lines": list(items), "anchor": anchor}
 
 
 def _finding_lines(findings: Sequence[Finding]) -> list[str]:
@@ -260,7 +179,7 @@ def _jump_lines(analysis: Analysis, summary: Mapping[str, Any]) -> list[str]:
     )
 
 
-def _alerts(analysis: Analysis, summary: Mapping[str, Any]) -> str:
+def _alerts(analysis: Analysis, summary: Mapping[str, Any]) -> list[dict[str, Any]]:
     """The banner: hard limits, soft limits, then notes and large acceleration jumps (camcad.findings)."""
     hard = [f for f in analysis.findings if f.hard]
     soft = [f for f in analysis.findings if not f.hard]
@@ -278,7 +197,7 @@ def _alerts(analysis: Analysis, summary: Mapping[str, Any]) -> str:
         out.append(_alert("warn", f"Notes ({len(notes)})", notes, anchor=anchor))
     if not out:
         out.append(_alert("ok", "No warnings", ["Every checked limit is met."], anchor="warnings"))
-    return "\n".join(out)
+    return out
 
 
 # ---------------------------------------------------------------------------
@@ -320,16 +239,11 @@ def _key_numbers(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, An
     }
 
 
-def _card(label: str, value: str, note: str = "", *, over: bool = False) -> str:
-    cls = "card over" if over else "card"
-    note_html = f'<div class="note">{_e(note)}</div>' if note else ""
-    return (
-        f'<div class="{cls}"><div class="label">{_e(label)}</div>'
-        f'<div class="value">{_e(value)}</div>{note_html}</div>'
-    )
+def _card(label: str, value: str, note: str = "", *, over: bool = False) -> dict[str, Any]:
+    return {"label": label, "value": value, "note": note, "over": over}
 
 
-def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
+def _cards(analysis: Analysis, k: Mapping[str, Any]) -> list[dict[str, Any]]:
     cam = analysis.cam
     follower = cam.kinematics.describe()
     alpha_over = k["alpha"] > k["alpha_limit"]
@@ -416,36 +330,36 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
         fit_card,
         *([gcode_card] if gcode is not None else []),
     ]
-    return '<section class="cards" id="key-numbers">' + "".join(cards) + "</section>"
+    return cards
 
 
-def _program_table(analysis: Analysis) -> str:
+def _program_table(analysis: Analysis) -> dict[str, Any]:
     program = analysis.cam.program
     rows = []
     for i, (seg, start) in enumerate(zip(program.segments, program.segment_bounds, strict=True)):
         law = seg.law.describe() if seg.law is not None else _DASH
         rows.append(
             [
-                _e(i),
-                _e(seg.kind.value),
-                _e(_num(math.degrees(start), ".2f")),
-                _e(_num(math.degrees(seg.span), ".2f")),
-                _e(_num(seg.lift, ".3f")),
-                _e(law),
+                i,
+                seg.kind.value,
+                _num(math.degrees(start), ".2f"),
+                _num(math.degrees(seg.span), ".2f"),
+                _num(seg.lift, ".3f"),
+                law,
             ]
         )
     lift = f"lift [{analysis.cam.follower.kind.lift.short}]"
     header = ["#", "segment", "start [°]", "span [°]", lift, "law"]
-    return _table(header, rows)
+    return {"header": header, "rows": rows}
 
 
-def _design_table(analysis: Analysis) -> str:
+def _design_table(analysis: Analysis) -> list[list[str]]:
     design, cam = analysis.design, analysis.cam
     spec = design.cam
     rows = [
         ("follower type", design.follower.kind.word),
         ("base radius [mm]", _num(spec.base_radius)),
-        ("follower", _e(cam.kinematics.describe())),
+        ("follower", cam.kinematics.describe()),
         *((label, _DASH if value is None else _num(value)) for label, value in cam.kinematics.rows()),
         ("rotation", spec.rotation.value),
         ("speed [rpm]", _num(spec.speed_rpm)),
@@ -453,49 +367,59 @@ def _design_table(analysis: Analysis) -> str:
         ("bore diameter [mm]", _num(spec.bore)),
         ("max pressure angle [°]", _num(math.degrees(spec.max_pressure_angle))),
     ]
-    return _table(None, [[_e(a), _e(b)] for a, b in rows])
+    return [[a, b] for a, b in rows]
 
 
-def _quantities_table(section: Mapping[str, Any], *, skip: Sequence[str] = ()) -> str:
+def _quantities_table(section: Mapping[str, Any], *, skip: Sequence[str] = ()) -> dict[str, Any]:
     """A section of ``summary.json`` as quantity [unit] | value | where, nested sections below it."""
-    rows = [[_e(q), _e(v), _e(w)] for q, v, w in quantity_rows(section, skip=skip)]
-    out = [_table(["quantity", "value", "where"], rows)] if rows else []
+    rows = [[q, v, w] for q, v, w in quantity_rows(section, skip=skip)]
+    nested: list[dict[str, Any]] = []
     for key, value in section.items():
         if key in skip:
             continue
         if isinstance(value, Mapping):
-            out.append(f"<h4>{_e(label(key))}</h4>{_quantities_table(value, skip=('warnings',))}")
+            nested.append(
+                {
+                    "title": label(key),
+                    "records": None,
+                    "section": _quantities_table(value, skip=("warnings",)),
+                }
+            )
         elif _is_records(value):
-            out.append(f"<h4>{_e(label(key))}</h4>{_records_table(value)}")
-    return "".join(out) or f"<p>{_DASH}</p>"
+            nested.append({"title": label(key), "records": _records_table(value), "section": None})
+    return {"rows": rows, "nested": nested}
 
 
-def _records_table(records: Sequence[Mapping[str, Any]]) -> str:
+def _has_records(table: Mapping[str, Any]) -> bool:
+    """Whether a :func:`_quantities_table` holds a records table at any depth (it then spans the page)."""
+    return any(n["records"] is not None or _has_records(n["section"]) for n in table["nested"])
+
+
+def _records_table(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     keys: list[str] = []
     for rec in records:
         keys += [k for k in rec if k not in keys]
-    header = [_e(label(k)) for k in keys]
-    rows = [[_e(fmt(rec.get(k), split_unit(k)[1])) for k in keys] for rec in records]
-    return f'<div class="scroll records">{_table(header, rows)}</div>'
+    header = [label(k) for k in keys]
+    rows = [[fmt(rec.get(k), split_unit(k)[1]) for k in keys] for rec in records]
+    return {"header": header, "rows": rows}
 
 
 _SECTION_TITLES = {"gcode": "G-code", "fit": "NURBS fit", "second_plate": "Second plate"}
 _NOT_TABLES = ("camcad_version", "design", "warnings", "violations", "findings")
 
 
-def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
-    out = ['<section class="tables" id="tables">']
-    out.append(f"<div><h3>Design</h3>{_design_table(analysis)}</div>")
-    out.append(f"<div><h3>Motion program</h3>{_program_table(analysis)}</div>")
+def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, Any]:
+    """The tables of the report: the design, the motion program, each summary section, the joints."""
+    sections = []
     for name, section in summary.items():
         if name in _NOT_TABLES or not isinstance(section, Mapping):
             continue
         title = _SECTION_TITLES.get(name, name.replace("_", " ").capitalize())
         body = _quantities_table(section, skip=("warnings", "joints"))
-        wide = ' class="wide"' if 'class="scroll records"' in body else ""  # a records table: full width
-        out.append(f'<div id="table-{_e(name)}"{wide}><h3>{_e(title)}</h3>{body}</div>')
+        sections.append({"name": name, "title": title, "body": body, "wide": _has_records(body)})
     motion = summary.get("motion", {})
     joints = motion.get("joints")
+    table = None
     if joints:
         unit = analysis.cam.follower.kind.lift_unit
         header, rows = joint_rows(
@@ -505,80 +429,72 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
             mass_kg=analysis.design.dynamics.follower_mass,
             speed_rpm=analysis.design.cam.speed_rpm,
         )
-        table = _table([_e(h) for h in header], [[_e(c) for c in row] for row in rows])
-        out.append(
-            '<div class="wide" id="table-joints"><h3>Motion joints: what each jump means</h3>'
-            f'<div class="scroll">{table}</div></div>'
-        )
-    out.append("</section>")
-    return "\n".join(out)
+        table = {"header": header, "rows": rows}
+    return {
+        "design_rows": _design_table(analysis),
+        "program": _program_table(analysis),
+        "sections": sections,
+        "joints": table,
+    }
 
 
 # ---------------------------------------------------------------------------
 # public API
 
 
-def _fea_section(analysis: Analysis) -> str:
+def _fea_section(analysis: Analysis) -> dict[str, Any] | None:
     """The finite-element check (issue 22): a table of its load cases and a stress picture per case."""
     fea = getattr(analysis, "fea", None)
     if fea is None:
-        return ""
+        return None
     from camcad.fea.plot import stress_figures
 
     rows = [
         [
-            _e(i),
-            _e(sc.case.label),
-            _e(_num(sc.case.angle_deg, ".2f")),
-            _e(_num(sc.case.force, ".2f")),
-            _e(_num(sc.case.peak_pressure, ".1f")),
-            _e(_num(sc.peak.value, ".1f")),
-            _e(sc.peak.where),
+            i,
+            sc.case.label,
+            _num(sc.case.angle_deg, ".2f"),
+            _num(sc.case.force, ".2f"),
+            _num(sc.case.peak_pressure, ".1f"),
+            _num(sc.peak.value, ".1f"),
+            sc.peak.where,
         ]
         for i, sc in enumerate(fea.cases, start=1)
     ]
     header = ["case", "load case", "φ [°]", "force [N]", "Hertz p0 [MPa]", "von Mises [MPa]", "where"]
     limit = "no allowable set" if fea.allowable_stress is None else f"allowable {fea.allowable_stress:g} MPa"
-    figures = "".join(
-        _img(Plot(key=f"fea-{i}", title=title, caption=caption, png=png))
+    figures = [
+        _figure(Plot(key=f"fea-{i}", title=title, caption=caption, png=png))
         for i, (title, caption, png) in enumerate(stress_figures(fea), start=1)
-    )
-    return (
-        f'<h2 id="fea-heading">Finite-element check</h2>\n<section id="fea">'
-        f"<p>{_e(fea.plane.value.join(('Plane ', ' model')))}, {len(fea.nodes)} nodes, {len(fea.cells)} "
-        f"quadratic triangles; {_e(limit)}; fields in stress.vtu.</p>{_table(header, rows)}"
-        f'<section class="plots">{figures}</section></section>'
-    )
+    ]
+    return {
+        "model": fea.plane.value.join(("Plane ", " model")),
+        "nodes": len(fea.nodes),
+        "cells": len(fea.cells),
+        "limit": limit,
+        "header": header,
+        "rows": rows,
+        "figures": figures,
+    }
 
 
-def _duty_section(analysis: Analysis) -> str:
+def _duty_section(analysis: Analysis) -> list[dict[str, Any]] | None:
     """Life, lubricant film and drive (issue 35): a figure each; their numbers are in the tables."""
     duty = getattr(analysis, "duty", None)
     if duty is None:
-        return ""
+        return None
     from camcad._plots.duty import duty_plots
 
-    figures = "".join(_img(p) for p in duty_plots(analysis))
-    return (
-        '<h2 id="duty-heading">Life, lubrication and drive</h2>\n<section id="duty">'
-        "<p>The numbers are in the tables <i>Life</i>, <i>Lubrication</i> and <i>Drive</i> below.</p>"
-        f'<section class="plots">{figures}</section></section>'
-    )
+    return [_figure(p) for p in duty_plots(analysis)]
 
 
-def _vibration_section(analysis: Analysis) -> str:
+def _vibration_section(analysis: Analysis) -> list[dict[str, Any]] | None:
     """The elastic follower train (issue 34): the speed map and the response at the design speed."""
     if getattr(analysis, "vibration", None) is None:
-        return ""
+        return None
     from camcad._plots.vibration import vibration_plots
 
-    figures = "".join(_img(p) for p in vibration_plots(analysis))
-    return (
-        '<h2 id="vibration-heading">Cams at speed</h2>\n<section id="vibration">'
-        "<p>The follower train as the <code>[vibration]</code> table states it; the numbers are in the "
-        "table <i>Vibration</i> below, vibration.csv and speed_map.csv.</p>"
-        f'<section class="plots">{figures}</section></section>'
-    )
+    return [_figure(p) for p in vibration_plots(analysis)]
 
 
 def render_report(analysis: Analysis) -> str:
@@ -598,52 +514,44 @@ def render_report(analysis: Analysis) -> str:
         ``data:`` URIs) and the tables of ``summary.json`` in words with units.
         Laid out for any width and for print (A4 or Letter: the drawing and
         the key numbers on page 1). Pure and deterministic: writes nothing,
-        holds no time.
+        holds no time. The layout is ``camcad/templates/report.html.j2``.
     """
     summary = analysis.summary()
     name = analysis.design.cam.name
     source = analysis.design.source
-    version = summary.get("camcad_version", "")
     sub = [
         f"source: {source}" if source else "",
         analysis.cam.kinematics.describe(),
         f"speed {analysis.design.cam.speed_rpm:g} rpm",
     ]
-    header = f"<header><h1>{_e(name)}</h1><p>{_e(' · '.join(s for s in sub if s))}</p></header>"
     plots = report_plots(analysis)
     drawing = next((p for p in plots if p.key == "profile"), None)
-    rest = "".join(_img(p, cls="small" if p.key == "solid" else "") for p in plots if p is not drawing)
-    glance = (
-        '<section class="glance" id="glance">'
-        + (_img(drawing) if drawing is not None else "")
-        + _cards(analysis, _key_numbers(analysis, summary))
-        + "</section>"
+    return _render(
+        "report.html.j2",
+        title=f"camcad report: {name}",
+        css=Markup(CSS),  # the package's own style sheet, written as it is
+        name=name,
+        subtitle=" · ".join(s for s in sub if s),
+        alerts=_alerts(analysis, summary),
+        drawing=None if drawing is None else _figure(drawing),
+        cards=_cards(analysis, _key_numbers(analysis, summary)),
+        plots=[_figure(p, cls="small" if p.key == "solid" else "") for p in plots if p is not drawing],
+        fea=_fea_section(analysis),
+        duty=_duty_section(analysis),
+        vibration=_vibration_section(analysis),
+        version=summary.get("camcad_version", ""),
+        **_summary_tables(analysis, summary),
     )
-    body = "\n".join(
-        [
-            header,
-            _alerts(analysis, summary),
-            glance,
-            f'<h2 id="plots-heading">Plots</h2>\n<section class="plots" id="plots">{rest}</section>',
-            _fea_section(analysis),
-            _duty_section(analysis),
-            _vibration_section(analysis),
-            "<h2>Tables</h2>",
-            _summary_tables(analysis, summary),
-            f"<footer>camcad {_e(version)} · angles in degrees, lengths in mm</footer>",
-        ]
-    )
-    return _page(f"camcad report: {name}", body)
 
 
 def key_numbers_html(analysis: Analysis) -> str:
     """The report's key-number cards of one analysis, as an HTML fragment (the designer shows them live)."""
-    return _cards(analysis, _key_numbers(analysis, analysis.summary()))
+    return _render("cards.html.j2", cards=_cards(analysis, _key_numbers(analysis, analysis.summary())))
 
 
 def alerts_html(analysis: Analysis) -> str:
     """The report's warning banner of one analysis, as an HTML fragment."""
-    return _alerts(analysis, analysis.summary())
+    return _render("alerts.html.j2", alerts=_alerts(analysis, analysis.summary()))
 
 
 def write_report(analysis: Analysis, path: str | Path) -> Path:
@@ -765,8 +673,6 @@ def render_compare(analyses: Sequence[Analysis]) -> str:
         raise ValueError("render_compare needs at least one analysis")
     names = _names(analyses)
     table = compare_table(analyses)
-    header = [_e(h) for h in table[0]]
-    rows = [[_e(c) for c in row] for row in table[1:]]
     alerts = []
     for name, analysis in zip(names, analyses, strict=True):
         said = {f.message for f in analysis.findings}
@@ -776,24 +682,20 @@ def render_compare(analyses: Sequence[Analysis]) -> str:
             alerts.append(_alert("bad" if analysis.violations else "warn", name, findings))
     if not alerts:
         alerts.append(_alert("ok", "No warnings", ["Every design meets its checked limits."]))
-    plots = "".join(_img(p) for p in compare_plots(analyses, names))
-    key = "".join(
-        f'<li><span class="swatch" style="border-top-color:{color}"></span>{_e(name)}</li>'
-        for name, color in zip(names, compare_colors(len(names)), strict=True)
+    return _render(
+        "compare.html.j2",
+        title="camcad comparison",
+        css=Markup(CSS),
+        count=len(analyses),
+        names=names,
+        alerts=alerts,
+        table={"header": table[0], "rows": table[1:]},
+        key=[
+            {"name": name, "color": color}
+            for name, color in zip(names, compare_colors(len(names)), strict=True)
+        ],
+        plots=[_figure(p) for p in compare_plots(analyses, names)],
     )
-    body = "\n".join(
-        [
-            f"<header><h1>Comparison of {len(analyses)} cam designs</h1>"
-            f"<p>{_e(' · '.join(names))}</p></header>",
-            *alerts,
-            '<h2>Side by side</h2><section id="compare-table"><div class="scroll">'
-            f"{_table(header, rows)}</div></section>",
-            f'<h2 id="plots-heading">Plots</h2>\n<ul class="key" id="key">{key}</ul>'
-            f'\n<section class="plots" id="plots">{plots}</section>',
-            "<footer>camcad · angles in degrees, lengths in mm</footer>",
-        ]
-    )
-    return _page("camcad comparison", body)
 
 
 def write_compare(analyses: Sequence[Analysis], path: str | Path) -> Path:

@@ -399,3 +399,112 @@ def test_every_follower_module_is_in_the_registry():
     ]
     assert len(declared) == len(FOLLOWER_TYPES) >= 5
     assert {k.word.replace("-", "_") for k in FOLLOWER_TYPES.values()} == set(declared)
+
+
+# A name or a module whose own name starts with one underscore (``_SECTIONS``, ``plan._breaks``,
+# ``motion/_lawbase.py``) is private to the package that holds it: that package's modules and its
+# subpackages may import it, no other camcad module may (a name the others need is made public, or the
+# code moves). ``camcad._typing`` and the like are private to ``camcad`` itself, so any camcad module
+# may use them; ``camcad._plots._base`` only ``camcad._plots``.
+
+
+def _is_private(name: str) -> bool:
+    return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
+
+
+def private_imports(sources: Mapping[str, tuple[ast.Module, bool]]) -> list[str]:
+    """Each use of a private camcad name outside its package: ``module:line -> dotted.name``.
+
+    ``sources`` maps a module's name to its parsed source and whether it is a package's
+    ``__init__``. Every import counts (those under ``if TYPE_CHECKING:`` too), and so does an
+    attribute of an imported camcad module (``plan._breaks`` after ``from camcad.toolpath import plan``).
+    """
+    packages = {name for name, (_, is_package) in sources.items() if is_package}
+    found: list[str] = []
+    for module, (tree, is_package) in sorted(sources.items()):
+        package = module if is_package else module.rpartition(".")[0]
+
+        def check(target: str, line: int, module: str = module, package: str = package) -> None:
+            parts = target.split(".")
+            for k in range(1, len(parts)):
+                if not _is_private(parts[k]):
+                    continue
+                owner = ".".join(parts[:k])  # the module or package that defines parts[k]
+                home = owner if owner in packages else owner.rpartition(".")[0]
+                if package != home and not package.startswith(home + "."):
+                    found.append(f"{module}:{line} -> {target}")
+                    return
+
+        bound: dict[str, str] = {}  # local name -> the camcad module it stands for
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                    source = ".".join([*base, node.module] if node.module else base)
+                else:
+                    source = node.module or ""
+                if source != "camcad" and not source.startswith("camcad."):
+                    continue
+                for alias in node.names:
+                    target = f"{source}.{alias.name}"
+                    if target in sources:
+                        bound[alias.asname or alias.name] = target
+                    check(target, node.lineno)
+            elif isinstance(node, ast.Import):
+                for alias in node.names:
+                    if alias.name == "camcad" or alias.name.startswith("camcad."):
+                        bound[alias.asname or alias.name] = alias.name
+                        check(alias.name, node.lineno)
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute) and _is_private(node.attr):
+                value = ast.unparse(node.value)
+                if value in bound:
+                    check(f"{bound[value]}.{node.attr}", node.lineno)
+    return sorted(set(found))
+
+
+def test_no_private_name_is_used_outside_its_package():
+    sources = {name: (tree, path.name == "__init__.py") for name, (path, tree) in _sources().items()}
+    found = private_imports(sources)
+    assert not found, "private names used outside their package (make them public, or move the code):\n" + (
+        "\n".join(found)
+    )
+
+
+def test_private_rule_flags_names_modules_and_attributes_across_packages():
+    def tree(text: str) -> ast.Module:
+        return ast.parse(text)
+
+    sources = {
+        "camcad": (tree("def _exit(): pass\n"), True),
+        "camcad._typing": (tree(""), False),
+        "camcad.toolpath": (tree(""), True),
+        "camcad.toolpath.plan": (tree("def _breaks(): pass\n"), False),
+        "camcad.toolpath.groove": (tree("from camcad.toolpath.plan import _breaks\n"), False),  # sibling
+        "camcad.toolpath.arcs": (tree("from ..plan import _breaks\n"), True),  # a subpackage
+        "camcad.design": (tree(""), True),
+        "camcad.design.tables": (tree("_SECTIONS = {}\n"), False),
+        "camcad.design.editor": (tree("from camcad.design.tables import _SECTIONS\n"), False),
+        "camcad.export": (tree(""), True),
+        "camcad.export.a": (tree("from camcad.toolpath.plan import Toolpath, _breaks\n"), False),
+        "camcad.export.b": (tree("from camcad.toolpath import plan\nx = plan._breaks(1)\n"), False),
+        "camcad.export.c": (tree("import camcad.toolpath.plan\ncamcad.toolpath.plan._breaks()\n"), False),
+        "camcad.export.d": (
+            tree(
+                "from typing import TYPE_CHECKING\n"
+                "if TYPE_CHECKING:\n"
+                "    from camcad.design.tables import _SECTIONS\n"
+            ),
+            False,
+        ),
+        "camcad.export.e": (tree("from camcad.toolpath._pieces import Piece\n"), False),  # a private module
+        "camcad.export.f": (tree("from camcad._typing import FloatArray\nfrom camcad import _exit\n"), False),
+        "camcad.export.g": (tree("from camcad.toolpath.plan import __all__, Toolpath\n"), False),  # dunder
+    }
+    assert private_imports(sources) == [
+        "camcad.export.a:1 -> camcad.toolpath.plan._breaks",
+        "camcad.export.b:2 -> camcad.toolpath.plan._breaks",
+        "camcad.export.c:2 -> camcad.toolpath.plan._breaks",
+        "camcad.export.d:3 -> camcad.design.tables._SECTIONS",
+        "camcad.export.e:1 -> camcad.toolpath._pieces.Piece",
+    ]

@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 from camcad.design import FOLLOWER_TYPES, DynamicsModel, Rotation, load_design, parse_design
-from camcad.design.schema import _SECTIONS
+from camcad.design.tables import _SECTIONS
 from camcad.errors import DesignError
 from tests.conftest import SAMPLES
 

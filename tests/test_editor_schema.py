@@ -29,7 +29,7 @@ from hypothesis import strategies as st
 from camcad.cli import main
 from camcad.design import parse_design
 from camcad.design.editor_schema import design_json_schema, rule_schema
-from camcad.design.schema import _LAW_RULES, _MOTION_RULES, _SECTIONS
+from camcad.design.tables import _LAW_RULES, _MOTION_RULES, _SECTIONS
 from camcad.errors import DesignError, ValueRuleError
 from camcad.motion.laws import LAWS
 

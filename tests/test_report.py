@@ -13,7 +13,9 @@ import pytest
 from camcad.design import load_design
 from camcad.pipeline import analyse, build
 from camcad.report import (
+    alerts_html,
     compare_table,
+    key_numbers_html,
     render_compare,
     render_report,
     write_compare,
@@ -205,6 +207,42 @@ def test_report_lists_every_warning_escaped(warned):
     assert page.index('id="warnings"') < page.index('id="plots"')
     assert "not run" in parsed.plain  # no fit
     assert len(parsed.images) == N_REPORT_PLOTS - 1  # no fit, no fit-error figure
+
+
+EVIL_NAME = "<script>alert(\"x\")</script><img src=x onerror=alert(1)> \x01 & 'q'"
+
+
+def test_a_script_in_the_design_name_is_inert(analysis):
+    """The templates escape every value (autoescape): a name with markup stays text, in every page."""
+    cam = replace(analysis.design.cam, name=EVIL_NAME)
+    evil = replace(analysis, design=replace(analysis.design, cam=cam))
+    for page in (render_report(evil), render_compare([evil, analysis])):
+        assert_offline(page)  # no <script anywhere
+        parsed = parse(page)
+        assert "script" not in parsed.tags and "onerror" not in {name for name, _ in parsed.attrs}
+        assert parsed.tags.count("img") == len(parsed.images)
+        assert all(img["src"].startswith("data:image/") for img in parsed.images)  # only the figures
+        shown = EVIL_NAME.replace("\x01", "\ufffd")  # a control character becomes U+FFFD
+        assert " ".join(shown.split()) in parsed.plain
+    fragments = key_numbers_html(evil) + alerts_html(evil)
+    assert "<script" not in fragments and "onerror=" not in fragments.replace("onerror=alert", "")
+
+
+def test_the_templates_ship_as_package_data():
+    """Every file of camcad/templates is matched by pyproject's package data (so a wheel holds it)."""
+    import fnmatch
+
+    from camcad.design.schema import tomllib  # tomllib, or tomli on Python 3.10
+
+    root = SAMPLES.parent
+    config = tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))
+    patterns = config["tool"]["setuptools"]["package-data"]["camcad"]
+    shipped = sorted((root / "camcad" / "templates").iterdir())
+    assert {p.suffix for p in shipped} >= {".j2", ".css"}
+    for path in shipped:
+        rel = path.relative_to(root / "camcad").as_posix()
+        assert any(fnmatch.fnmatch(rel, pat) for pat in patterns), rel
+    assert any(dep.startswith("jinja2") for dep in config["project"]["dependencies"])
 
 
 def test_render_is_deterministic(analysis, page):

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from camcad._plots._base import Plot, figure, plot_text, svg
+from camcad._plots._base import Plot, figure, plot_text, svg, trace_name
 from camcad._plots.compare import compare_plots
 from camcad._plots.design import (
     CURVATURE_CLIP,
@@ -38,6 +38,7 @@ __all__ = [
     "plot_text",
     "report_plots",
     "svg",
+    "trace_name",
 ]
 
 

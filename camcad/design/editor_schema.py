@@ -4,7 +4,7 @@ Editors that read JSON Schema for TOML (VS Code with Even Better TOML, any
 editor with the Taplo language server) then complete keys, offer the allowed
 words and flag a value out of range while the file is typed. The schema is
 generated from the same rule table :func:`camcad.design.parse_design` checks
-(one rule per key in :mod:`camcad.design.schema`, and one per law parameter):
+(one rule per key in :mod:`camcad.design.tables`, and one per law parameter):
 the type and the words come from the rule, the bounds (open or closed, "0 or
 a range", odd integers, list lengths) from the JSON Schema keywords each
 check declares beside its test, so the two cannot drift apart.
@@ -20,13 +20,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from camcad.design.schema import (  # the loader's rules, read only
+from camcad.design.rules import _Rule
+from camcad.design.tables import (  # the loader's rules, read only
     _BOUNDARY_RULE,
     _LAW_RULES,
     _MOTION_RULES,
     _SECTIONS,
     _TABLE_ANGLE_RULE,
-    _Rule,
 )
 from camcad.geometry.followers import DEFAULT_FOLLOWER, FOLLOWER_TYPES, follower_keys
 

@@ -55,7 +55,7 @@ from camcad.findings import Finding, Severity
 from camcad.motion.segments import SegmentKind
 
 if TYPE_CHECKING:
-    from camcad.motion._lawbase import Law
+    from camcad.motion.laws import Law
     from camcad.motion.program import MotionProgram
 
 __all__ = [

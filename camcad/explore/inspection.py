@@ -131,7 +131,7 @@ def _polar_figure(ins: Inspection) -> str:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from camcad._plots._base import svg
+    from camcad._plots import svg
 
     lower, upper = ins.band
     width = upper - lower
@@ -157,7 +157,7 @@ def _polar_figure(ins: Inspection) -> str:
 
 
 def _motion_figure(cam: Cam, act: ActualMotion, unit: str) -> str:
-    from camcad._plots._base import figure, svg
+    from camcad._plots import figure, svg
 
     nominal = cam.motion(act.phi)
     fig = figure((7.0, 5.2), hspace=0.3)

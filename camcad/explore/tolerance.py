@@ -478,7 +478,7 @@ def _envelope(cam: Cam, spec: ToleranceSpec, phi: FloatArray) -> dict[str, tuple
 
 
 def _band_figure(bands: Bands, key: str, label: str, envelope: tuple[FloatArray, FloatArray] | None) -> str:
-    from camcad._plots._base import figure, svg
+    from camcad._plots import figure, svg
 
     fig = figure((7.0, 3.0))
     ax = fig.add_subplot()

@@ -62,7 +62,7 @@ import numpy as np
 from camcad._typing import FloatArray, readonly
 from camcad.errors import DesignError
 from camcad.geometry.envelope import PointElement
-from camcad.geometry.followers._arm import arm_swing, turning_point
+from camcad.geometry.followers import arm_swing, turning_point
 from camcad.geometry.followers.base import slide_point
 from camcad.motion.program import Motion
 

@@ -46,6 +46,7 @@ from camcad.motion._vap import Vap
 __all__ = [
     "DUDLEY_MAX_DEGREE",
     "LAWS",
+    "MAX_POLYNOMIAL_DEGREE",
     "ConstantVelocity",
     "Cycloidal",
     "Derivatives",

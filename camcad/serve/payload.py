@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camcad._plots._base import trace_name
+from camcad._plots import trace_name
 from camcad._plots.design import (
     CURVATURE_CLIP,
     bore_outline,

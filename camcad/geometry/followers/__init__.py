@@ -23,6 +23,7 @@ import pkgutil
 from collections.abc import Mapping
 from types import MappingProxyType
 
+from camcad.geometry.followers._arm import arm_swing, turning_point
 from camcad.geometry.followers.base import Follower, FollowerKey, FollowerSketch, FollowerType, Lift, Words
 from camcad.geometry.followers.oscillating_flat import OscillatingFlat
 from camcad.geometry.followers.oscillating_roller import OscillatingRoller
@@ -42,7 +43,9 @@ __all__ = [
     "TranslatingFlat",
     "TranslatingRoller",
     "Words",
+    "arm_swing",
     "follower_keys",
+    "turning_point",
 ]
 
 

@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from camcad.cli import _vibration_rows, main
+from camcad.cli import main
+from camcad.cli.render import _vibration_rows
 from camcad.design import load_design, parse_design
 from camcad.dynamics.vibration import Train, TrainModel, VibrationSpec
 from camcad.errors import DesignError
