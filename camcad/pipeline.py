@@ -23,6 +23,7 @@ from typing import Any
 from camcad.analysis import Analysis, PartResult, motion_summary
 from camcad.design import Design, load_design
 from camcad.dynamics import DynamicsResult, analyse_dynamics
+from camcad.dynamics.spec import DynamicsSetup
 from camcad.errors import DesignLimitError, ExportError, FitError, GougeError, UsageError
 from camcad.export.atomic import staged_folder
 from camcad.export.records import write_json, write_text
@@ -181,13 +182,16 @@ def analyse(
         raise DesignLimitError(hard[0].message)
     setup = design.dynamics_setup()
 
+    def setup_of(part: Part) -> DynamicsSetup:
+        # each part's own roller sets its Hertz contact (Johnson 1985, §4.3), its drive sign its force
+        return replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius)
+
     def dynamics_of(part: Part, geometry: GeometryAnalysis) -> DynamicsResult:
         return analyse_dynamics(
             part.cam.motion(geometry.phi),
             pressure_angle=geometry.pressure_angle,
             profile_rho=geometry.profile.rho,
-            # each part's own roller sets its Hertz contact (Johnson 1985, §4.3), its drive sign its force
-            setup=replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius),
+            setup=setup_of(part),
             cam=part.cam,
         )
 
@@ -201,24 +205,30 @@ def analyse(
         PartResult(part=part, geometry=g, dynamics=d)
         for part, g, d in zip(parts, geometries, dynamics, strict=True)
     ]
-    duty = None
+    drive = None
     if design.life is not None or design.lubrication is not None or design.drive is not None:
-        from camcad.dynamics.duty import analyse_duty
+        from camcad.dynamics.duty import analyse_duty, analyse_train_drive
 
-        duty = _timed(
-            timings,
-            progress,
-            "duty",
-            lambda: analyse_duty(
-                cam,
-                dynamics[0],
-                setup=setup,
-                profile=geometries[0].profile,
+        def duty_of(result: PartResult) -> PartResult:  # every part's life and film, by the same code
+            if design.life is None and design.lubrication is None:
+                return result
+            duty = analyse_duty(
+                result.part.cam,
+                result.dynamics,
+                setup=setup_of(result.part),
+                profile=result.geometry.profile,
                 life=design.life,
                 lubrication=design.lubrication,
-                drive=design.drive,
-            ),
-        )
+            )
+            return replace(result, duty=duty)
+
+        def duties() -> tuple[list[PartResult], Any]:
+            train = None  # the motor turns the camshaft: a figure of the train, not of a part
+            if design.drive is not None:
+                train = analyse_train_drive(cam, dynamics[0], setup=setup, spec=design.drive)
+            return [duty_of(r) for r in results], train
+
+        results, drive = _timed(timings, progress, "duty", duties)
     later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
     if fit and not hard:
         fit_curve = partial(
@@ -291,7 +301,7 @@ def analyse(
         timings=timings,
         stage_findings=tuple(later),
         fea=fea_result,
-        duty=duty,
+        drive=drive,
         vibration=vibration,
     )
 
@@ -655,10 +665,11 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
 
     cam, design = analysis.cam, analysis.design
     unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
-    duty = analysis.duty.csv_columns() if analysis.duty is not None else None  # life, film, drive columns
+    duty = analysis.duty.csv_columns() if analysis.duty is not None else {}  # the first part's film
+    duty |= analysis.drive.csv_columns() if analysis.drive is not None else {}  # the train's motor torque
     motion_csv = write_motion_csv(folder / "motion.csv", cam, unit=unit)
     profile_csv = write_profile_csv(folder / "profile.csv", analysis.geometry)
-    dynamics_csv = write_dynamics_csv(folder / "dynamics.csv", analysis.dynamics, extra=duty)
+    dynamics_csv = write_dynamics_csv(folder / "dynamics.csv", analysis.dynamics, extra=duty or None)
     return [
         motion_csv,
         profile_csv,

@@ -553,8 +553,7 @@ def _fea_section(analysis: Analysis) -> str:
 
 def _duty_section(analysis: Analysis) -> str:
     """Life, lubricant film and drive (issue 35): a figure each; their numbers are in the tables."""
-    duty = getattr(analysis, "duty", None)
-    if duty is None:
+    if analysis.duty is None and analysis.drive is None:
         return ""
     from camcad._plots.duty import duty_plots
 

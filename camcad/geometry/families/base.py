@@ -57,11 +57,16 @@ class Drive(TypedDict):
 
 
 class PartCheck(Protocol):
-    """A family's own check of a part (a groove's flanks): its findings and its summary figures."""
+    """A family's own check of a part (a groove's flanks): findings, radius margin, summary figures."""
 
     @property
     def findings(self) -> tuple[Finding, ...]:
         """The check's broken limits."""
+        ...
+
+    @property
+    def radius_margin(self) -> float:
+        """The smallest radius [mm] of the part's further curves that must stay positive (a flank's)."""
         ...
 
     def summary(self) -> dict[str, Any]:
@@ -174,6 +179,11 @@ class PartResults(Protocol):
     @property
     def flank_fits(self) -> tuple[Any, ...]:
         """A :class:`~camcad.fit.ProfileFit` per flank (``part.flanks``), or none."""
+        ...
+
+    @property
+    def duty(self) -> Any:
+        """Its :class:`~camcad.dynamics.duty.DutyResult` (life and film: ``summary()``), or None."""
         ...
 
 

@@ -57,7 +57,7 @@ class ConjugateFamily:
             raise DesignError(*problem)
 
     def summary(self, results: Sequence[PartResults]) -> dict[str, Any]:
-        """The ``second_plate`` section: its geometry, its dynamics and its fit."""
+        """The ``second_plate`` section: its geometry, its dynamics, its fit, its life and film."""
         second = results[1]
         plate: dict[str, Any] = {
             "single_plate": not second.part.made,
@@ -66,6 +66,8 @@ class ConjugateFamily:
         }
         if second.fit is not None:
             plate["fit"] = second.fit.summary()
+        if second.duty is not None:
+            plate |= second.duty.summary()  # its roller's and track's life, its film (its own roller)
         return {"second_plate": plate}
 
     def caption(self, parts: Sequence[Part]) -> str:
