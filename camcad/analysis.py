@@ -57,6 +57,9 @@ class PartResult:
     duty
         Its roller's and track's life and its lubricant film (``[life]``,
         ``[lubrication]``), by the same code for every part; None without either table.
+    fea
+        The finite-element check of a made plate (its own roller's contact
+        loads); None when not run, or for a part that is not a plate.
     """
 
     part: Part
@@ -66,12 +69,14 @@ class PartResult:
     flank_fits: tuple[ProfileFit, ...] = ()
     gcode: GcodeProgram | None = None
     duty: DutyResult | None = None
+    fea: FeaResult | None = None
 
     @property
     def findings(self) -> tuple[Finding, ...]:
-        """Its geometry's, family checks', dynamics' and duty's findings; a later part's name theirs."""
+        """Its geometry's, family checks', dynamics', FE's and duty's findings; a later part's name theirs."""
+        fea = self.fea.findings if self.fea is not None else ()
         duty = self.duty.findings if self.duty is not None else ()
-        found = (*self.geometry.findings, *self.part.findings, *self.dynamics.findings, *duty)
+        found = (*self.geometry.findings, *self.part.findings, *self.dynamics.findings, *fea, *duty)
         if not self.part.label:
             return found
         return tuple(replace(f, message=f"{self.part.label}: {f.message}") for f in found)
@@ -107,7 +112,6 @@ class Analysis:
     toolpath: Toolpath | None
     timings: dict[str, float] = field(default_factory=dict)
     stage_findings: tuple[Finding, ...] = ()
-    fea: FeaResult | None = None  # the finite-element check, when run ([fea] present, or asked for)
     drive: DriveDuty | None = None  # the follower train's drive ([drive]; issue 35)
     vibration: VibrationResult | None = None  # the elastic follower train ([vibration]; issue 34)
     _memo: dict[str, Any] = field(  # the motion summary, computed once (see summary)
@@ -128,6 +132,11 @@ class Analysis:
     def dynamics(self) -> DynamicsResult:
         """The first part's contact force, torque, Hertz stress (over the same angles)."""
         return self.parts[0].dynamics
+
+    @property
+    def fea(self) -> FeaResult | None:
+        """The first plate's finite-element check, when run ([fea], or asked); each plate's in ``parts``."""
+        return self.parts[0].fea
 
     @property
     def duty(self) -> DutyResult | None:

@@ -164,8 +164,8 @@ def _check_rows(summary: dict[str, Any], design: Any, *, positive_drive: bool) -
 def _duty_rows(summary: dict[str, Any], prefix: str = "") -> list[tuple[str, str]]:
     """The rows ``[life]``, ``[lubrication]`` and ``[drive]`` add to ``camcad check`` (issue 35).
 
-    ``summary`` is ``summary.json`` or a later part's section of it (a pair's
-    ``second_plate``), whose rows start with ``prefix``: the same rows for every part.
+    ``summary`` is ``summary.json`` or a later part's own sections (its duty's
+    summary), whose rows start with ``prefix``: the same rows for every part.
     """
     rows: list[tuple[str, str]] = []
     life, film, drive = summary.get("life"), summary.get("lubrication"), summary.get("drive")
@@ -297,7 +297,6 @@ def _positive_rows(summary: dict[str, Any], *, positive_drive: bool) -> list[tup
                 _fmt(dyn2.get("hertz_stress_max_MPa"), " MPa", 1) + _at(dyn2, "hertz_stress_max"),
             ),
         ]
-        rows += _duty_rows(second, "2nd plate ")  # its roller's life and its film, same rows
     if positive_drive:
         dyn = summary["dynamics"]
         crossings = ", ".join(f"{a:.1f}°" for a in dyn.get("crossover_angles_deg", [])) or "none"
@@ -307,17 +306,20 @@ def _positive_rows(summary: dict[str, Any], *, positive_drive: bool) -> list[tup
     return rows
 
 
-def _fea_rows(fea: dict[str, Any]) -> list[tuple[str, str]]:
-    """The finite-element check's rows of ``camcad check``: the peak von Mises stress, then each case."""
+def _fea_rows(fea: dict[str, Any], prefix: str = "") -> list[tuple[str, str]]:
+    """The finite-element check's rows of ``camcad check``: the peak von Mises stress, then each case.
+
+    ``prefix`` names a later plate's rows ("second plate "): the same rows for every plate.
+    """
     limit = fea.get("allowable_stress_MPa")
     peak = _fmt(fea.get("von_mises_max_MPa"), " MPa", 1)
     if fea.get("von_mises_max_angle_deg") is not None:
         peak += f" at {fea['von_mises_max_angle_deg']:.1f}°, {fea['von_mises_max_where']}"
-    rows = [("FE max von Mises", peak + (f" (limit {limit:g} MPa)" if limit is not None else ""))]
+    rows = [(f"{prefix}FE max von Mises", peak + (f" (limit {limit:g} MPa)" if limit is not None else ""))]
     for case in fea.get("cases", []):
         rows.append(
             (
-                f"  FE case {case['case']}",
+                f"  {prefix}FE case {case['case']}",
                 f"{case['label']} at {case['angle_deg']:.1f}°: von Mises {case['von_mises_max_MPa']:.1f} MPa "
                 f"(Hertz {case['hertz_stress_MPa']:.1f} MPa)",
             )
@@ -336,9 +338,15 @@ def _cmd_check(args: argparse.Namespace) -> int:
     rows = _check_rows(analysis.summary(), design, positive_drive=positive)
     rows += _positive_rows(analysis.summary(), positive_drive=positive)
     rows += _duty_rows(analysis.summary())
+    for later in analysis.parts[1:]:  # every further part's life and film (its own roller), the same rows
+        if later.duty is not None:
+            rows += _duty_rows(later.duty.summary(), f"{later.part.label} ")
     rows += _vibration_rows(analysis.summary())
     if analysis.fea is not None:
         rows += _fea_rows(analysis.summary()["fea"])
+    for later in analysis.parts[1:]:  # every further plate's FE check, the same rows
+        if later.fea is not None:
+            rows += _fea_rows(later.fea.summary(), f"{later.part.label} ")
     width = max(len(k) for k, _ in rows)
     print(f"{design.cam.name} ({args.design})")
     for key, value in rows:

@@ -289,9 +289,9 @@ def analyse(
             results[index] = replace(result, gcode=render(plan, design.gcode.dialect))
         if spent:
             timings["toolpath"] = spent  # every part's plan
-    fea_result = None
     if fea and not hard:
-        fea_result = _timed(timings, progress, "fea", lambda: _fea_check(design, family, parts, dynamics[0]))
+        fea_setups = [setup_of(r.part) for r in results]
+        results = _timed(timings, progress, "fea", lambda: _fea_check(design, family, results, fea_setups))
     return Analysis(
         design=design,
         family=family,
@@ -300,7 +300,6 @@ def analyse(
         toolpath=planned,
         timings=timings,
         stage_findings=tuple(later),
-        fea=fea_result,
         drive=drive,
         vibration=vibration,
     )
@@ -329,18 +328,27 @@ def _labelled(part: Part, findings: Iterable[Finding]) -> list[Finding]:
     return [replace(f, message=f"{part.label}: {f.message}") for f in findings]
 
 
-def _fea_check(design: Design, family: CamFamily, parts: Sequence[Part], dynamics: DynamicsResult) -> Any:
-    """The FE check of a family's one plate with the design's ``[fea]`` table (its defaults when absent)."""
+def _fea_check(
+    design: Design, family: CamFamily, results: Sequence[PartResult], setups: Sequence[DynamicsSetup]
+) -> list[PartResult]:
+    """The FE check of every made plate with the design's ``[fea]`` table (its defaults when absent).
+
+    Each plate is loaded by its own roller's contact (its dynamics, its setup),
+    by the same code; a part that is not a plate cut along its outline (a
+    groove's blank) or not made is not checked.
+    """
     from camcad.fea import FeaSpec, analyse_fea
 
-    if len(parts) != 1 or parts[0].pocket is not None:  # the FE model is one plate cut along its outline
-        raise UsageError(
-            "fea", f"the finite-element check applies to cam.style = 'plate' only, not {family.name}"
-        )
+    if not family.plates:  # the FE model is a plate cut along its outline, held at its bore
+        raise UsageError("fea", f"the finite-element check applies to plate cams only, not {family.name}")
     spec = design.fea if design.fea is not None else FeaSpec()
-    return analyse_fea(
-        parts[0].cam, design.plate(), setup=design.dynamics_setup(), dynamics=dynamics, spec=spec
-    )
+    plate = design.plate()
+    return [
+        replace(r, fea=analyse_fea(r.part.cam, plate, setup=s, dynamics=r.dynamics, spec=spec))
+        if r.part.made and r.part.pocket is None
+        else r
+        for r, s in zip(results, setups, strict=True)
+    ]
 
 
 _STAGE_LIMITS: dict[str, tuple[type[DesignLimitError], str, str]] = {
@@ -642,8 +650,8 @@ def _write_files(
     if "fea" in groups and analysis.fea is not None:
         from camcad.export.stress import write_stress_vtu
 
-        fea = analysis.fea
-        stage("stress", lambda: write_stress_vtu(folder / "stress.vtu", fea))
+        checked = [(r.part.suffix, r.fea) for r in made if r.fea is not None]  # every made plate's
+        stage("stress", lambda: [write_stress_vtu(folder / f"stress{sfx}.vtu", f) for sfx, f in checked])
     return written
 
 

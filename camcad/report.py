@@ -519,11 +519,15 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
 
 
 def _fea_section(analysis: Analysis) -> str:
-    """The finite-element check (issue 22): a table of its load cases and a stress picture per case."""
-    fea = getattr(analysis, "fea", None)
-    if fea is None:
-        return ""
+    """The finite-element check (issue 22) of every plate checked, by the same code (:func:`_fea_part`)."""
+    return "".join(_fea_part(r.fea, r.part) for r in analysis.parts if r.fea is not None)
+
+
+def _fea_part(fea: Any, part: Any) -> str:
+    """One plate's FE check: a table of its load cases and a stress picture per case."""
     from camcad.fea.plot import stress_figures
+
+    sfx = part.suffix
 
     rows = [
         [
@@ -540,13 +544,13 @@ def _fea_section(analysis: Analysis) -> str:
     header = ["case", "load case", "φ [°]", "force [N]", "Hertz p0 [MPa]", "von Mises [MPa]", "where"]
     limit = "no allowable set" if fea.allowable_stress is None else f"allowable {fea.allowable_stress:g} MPa"
     figures = "".join(
-        _img(Plot(key=f"fea-{i}", title=title, caption=caption, png=png))
+        _img(Plot(key=f"fea{sfx}-{i}", title=title, caption=caption, png=png))
         for i, (title, caption, png) in enumerate(stress_figures(fea), start=1)
     )
     return (
-        f'<h2 id="fea-heading">Finite-element check</h2>\n<section id="fea">'
+        f'<h2 id="fea{sfx}-heading">{_e(part.title("Finite-element check"))}</h2>\n<section id="fea{sfx}">'
         f"<p>{_e(fea.plane.value.join(('Plane ', ' model')))}, {len(fea.nodes)} nodes, {len(fea.cells)} "
-        f"quadratic triangles; {_e(limit)}; fields in stress.vtu.</p>{_table(header, rows)}"
+        f"quadratic triangles; {_e(limit)}; fields in stress{sfx}.vtu.</p>{_table(header, rows)}"
         f'<section class="plots">{figures}</section></section>'
     )
 

@@ -1211,9 +1211,14 @@ def _check_fea(design: Design) -> None:
     from camcad.fea.mesh import MAX_ELEMENTS, estimated_triangles, smallest_mesh_size
     from camcad.fea.model import keyway_fillet
 
-    if not family_of(design.cam.style).one_plate:
-        style = design.cam.style.value
-        raise DesignError("fea", f"the finite-element check applies to cam.style = 'plate' only, not {style}")
+    if not family_of(design.cam.style).plates:
+        style, allowed = (
+            design.cam.style.value,
+            " or ".join(repr(s.value) for s, f in FAMILIES.items() if f.plates),
+        )
+        raise DesignError(
+            "fea", f"the finite-element check applies to cam.style = {allowed} only, not {style}"
+        )
     bore = design.plate().bore
     if bore is None:
         raise DesignError(

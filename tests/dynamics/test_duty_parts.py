@@ -181,6 +181,6 @@ def test_a_grooves_outer_flank_film_has_that_flanks_curvature(groove):
 def test_a_pairs_check_rows_name_the_second_plates_life_and_film(pair):
     from camcad.cli import _duty_rows
 
-    rows = dict(_duty_rows(pair.summary()["second_plate"], "2nd plate "))
-    assert rows["2nd plate roller L10 life"].startswith(f"{pair.parts[1].duty.roller.hours:.4g} h")
-    assert "2nd plate min film ratio λ" in rows
+    rows = dict(_duty_rows(pair.summary()["second_plate"], "second plate "))
+    assert rows["second plate roller L10 life"].startswith(f"{pair.parts[1].duty.roller.hours:.4g} h")
+    assert "second plate min film ratio λ" in rows

@@ -182,6 +182,11 @@ class PartResults(Protocol):
         ...
 
     @property
+    def fea(self) -> Any:
+        """Its plate's :class:`~camcad.fea.results.FeaResult` (``summary()``), or None."""
+        ...
+
+    @property
     def duty(self) -> Any:
         """Its :class:`~camcad.dynamics.duty.DutyResult` (life and film: ``summary()``), or None."""
         ...
@@ -207,7 +212,12 @@ class CamFamily(Protocol):
 
     @property
     def one_plate(self) -> bool:
-        """Whether the family makes one plate cut along its outline (the FE check, the rotary machine)."""
+        """Whether the family makes one plate cut along its outline (the rotary machine)."""
+        ...
+
+    @property
+    def plates(self) -> bool:
+        """Whether each part made is a plate cut along its outline (the FE check holds each by its bore)."""
         ...
 
     def check(
