@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
@@ -110,7 +111,7 @@ class CarriedContact:
     load: FloatArray
     curvature: FloatArray
     motion: ContactMotion
-    outer: FloatArray | None = None
+    outer: npt.NDArray[np.bool_] | None = None
 
     def flank_at(self, i: int) -> str | None:
         """The groove flank that carries sample ``i`` (``"inner"``/``"outer"``), else None."""
@@ -184,7 +185,8 @@ def carried_contact(
         rolling=inner.rolling,
     )
     load = np.abs(f)
-    readonly(load, on_outer)
+    readonly(load)
+    on_outer.flags.writeable = False
     return CarriedContact(load=load, curvature=curvature, motion=contact, outer=on_outer)
 
 
