@@ -19,6 +19,7 @@ import pytest
 
 from camcad import pipeline
 from camcad.design import parse_design
+from camcad.explore.measures import measure_values
 
 C_RATING = 9000.0  # N
 P_EXP = 10.0 / 3.0  # ISO 281 roller bearings (the default exponent)
@@ -129,6 +130,10 @@ def test_each_plate_of_a_pair_has_its_own_roller_life(pair):
     assert summary["life"]["roller_life_h"] == lives[0]
     assert summary["second_plate"]["life"]["roller_life_h"] == lives[1]
     assert summary["second_plate"]["lubrication"]["min_film_ratio"] == second.duty.film.min_ratio
+    # the optimiser and the sweep hold every part to the limit: the shorter life, the thinner film
+    measures = measure_values(pair, summary)
+    assert measures["roller_life_h"] == min(lives)
+    assert measures["min_film_ratio"] == min(r.duty.film.min_ratio for r in pair.parts)
 
 
 def test_each_plate_of_a_pair_has_its_own_film(pair):
