@@ -33,12 +33,12 @@ def _series(phi_deg: np.ndarray, values: object, color: str, label: str = "") ->
     return Series(x=x, y=y, color=color, label=label)
 
 
-def _parts(analysis: Analysis) -> list[tuple[str, DutyResult]]:
-    """Every part's duty with its curves' label ("plate 2" beside "plate 1"; none for one part), same code."""
-    duties = [r.duty for r in analysis.parts if r.duty is not None]
+def _parts(analysis: Analysis) -> list[tuple[str, np.ndarray, DutyResult]]:
+    """Every part's curves' label ("plate 2" beside "plate 1"; none for one part), angles [deg] and duty."""
+    duties = [(np.degrees(r.dynamics.phi), r.duty) for r in analysis.parts if r.duty is not None]
     if len(duties) == 1:
-        return [("", duties[0])]
-    return [(f"plate {i}", d) for i, d in enumerate(duties, start=1)]
+        return [("", *duties[0])]
+    return [(f"plate {i}", phi, d) for i, (phi, d) in enumerate(duties, start=1)]
 
 
 def _named(label: str, text: str) -> str:
@@ -48,19 +48,18 @@ def _named(label: str, text: str) -> str:
 def life_plot(analysis: Analysis) -> Plot | None:
     """Each part's roller load over the turn against its equivalent load; its track's K when given."""
     parts = _parts(analysis)
-    if not parts or parts[0][1].life is None:
+    if not parts or parts[0][2].life is None:
         return None
-    phi = np.degrees(analysis.dynamics.phi)
     panels = []
     notes = []
-    rollers = [(label, d) for label, d in parts if d.roller is not None]
+    rollers = [(label, phi, d) for label, phi, d in parts if d.roller is not None]
     if rollers:
         series = [
             _series(phi, d.load, COLORS[4] if k == 0 else COLORS[1], label or "roller load")
-            for k, (label, d) in enumerate(rollers)
+            for k, (label, phi, d) in enumerate(rollers)
         ]
         lines = []
-        for k, (label, d) in enumerate(rollers):
+        for k, (label, _, d) in enumerate(rollers):
             assert d.roller is not None
             p = d.roller.equivalent_load
             lines.append(
@@ -86,10 +85,10 @@ def life_plot(analysis: Analysis) -> Plot | None:
                 height=140.0,
             )
         )
-    tracks = [(label, d) for label, d in parts if d.track is not None]
+    tracks = [(label, phi, d) for label, phi, d in parts if d.track is not None]
     if tracks:
         series = []
-        for k, (label, d) in enumerate(tracks):
+        for k, (label, phi, d) in enumerate(tracks):
             assert d.track is not None
             name = _named(label, "K = (F/L)(1/R₁ + 1/R₂)")
             series.append(_series(phi, d.track.factor, COLORS[6] if k == 0 else COLORS[1], name))
@@ -100,7 +99,7 @@ def life_plot(analysis: Analysis) -> Plot | None:
             )
         panels.append(Panel(ylabel="load-stress\nfactor K [MPa]", series=series, legend=True, height=140.0))
     if not panels:
-        sliding = float(np.max(parts[0][1].contact.sliding_speed))
+        sliding = float(np.max(parts[0][2].contact.sliding_speed))
         return Plot(
             key="life",
             title="Life",
@@ -117,7 +116,7 @@ def life_plot(analysis: Analysis) -> Plot | None:
 
 def film_plot(analysis: Analysis) -> Plot | None:
     """Each part's minimum film thickness and film ratio λ over the turn, λ's limit dashed."""
-    films = [(label, d.film) for label, d in _parts(analysis) if d.film is not None]
+    films = [(label, d.film) for label, _, d in _parts(analysis) if d.film is not None]
     if not films:
         return None
     limit = films[0][1].limit
