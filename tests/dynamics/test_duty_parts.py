@@ -74,14 +74,32 @@ def _points(curve_at, phi: np.ndarray) -> np.ndarray:
     return np.asarray(curve_at(phi).point, dtype=float)
 
 
-def _hand_l10_hours(cam, phi_part: np.ndarray, force_part: np.ndarray, roller: float) -> tuple[float, float]:
-    """L10 [h] and P [N] by hand: a uniform grid of 72 000 chords, the load interpolated onto it."""
+def _hand_l10_hours(
+    cam,
+    phi_part: np.ndarray,
+    force_part: np.ndarray,
+    roller: float,
+    flanks: tuple[float, float] | None = None,
+) -> tuple[float, float]:
+    """L10 [h] and P [N] by hand: a uniform grid of 72 000 chords, the load interpolated onto it.
+
+    ``flanks``: a groove's (inner, outer) offsets of the profile; the roller rolls on the inner
+    where F ≥ 0 and on the outer, carrying |F|, where F < 0.
+    """
     n = 72_000
     phi = np.arange(n) * (2.0 * math.pi / n)
-    pts = _points(cam.profile, phi)
-    ds = np.hypot(*(np.roll(pts, -1, axis=0) - pts).T)  # chord from φ_i to φ_i+1
     mid = phi + math.pi / n
-    load = np.clip(np.interp(mid, phi_part, force_part, period=2.0 * math.pi), 0.0, None)
+    force = np.interp(mid, phi_part, force_part, period=2.0 * math.pi)
+
+    def chords(curve_at) -> np.ndarray:
+        pts = _points(curve_at, phi)
+        return np.hypot(*(np.roll(pts, -1, axis=0) - pts).T)  # chord from φ_i to φ_i+1
+
+    if flanks is None:
+        ds, load = chords(cam.profile), np.clip(force, 0.0, None)
+    else:
+        inner, outer = (chords(lambda p, d=d: cam.offset(p, d)) for d in flanks)
+        ds, load = np.where(force < 0.0, outer, inner), np.abs(force)
     p_eq = (np.sum(load**P_EXP * ds) / np.sum(ds)) ** (1.0 / P_EXP)  # ISO 281 §7.2
     l10 = (C_RATING / p_eq) ** P_EXP  # ISO 281 §7, million revolutions
     turns = np.sum(ds) / (2.0 * math.pi * roller)  # per cam turn
@@ -181,6 +199,15 @@ def test_a_grooves_outer_flank_film_has_that_flanks_curvature(groove):
     lowest = int(np.argmin(film.ratio))
     flank = "outer" if force[lowest] < 0.0 else "inner"
     assert groove.summary()["lubrication"]["min_film_ratio_flank"] == flank
+
+
+def test_a_grooves_roller_rolls_on_the_flank_that_drives(groove):
+    (result,) = groove.parts
+    cam, dyn = result.part.cam, result.dynamics
+    flanks = (-0.1, 2.0 * cam.roller_radius + 0.1)  # ∓ c/2 beyond the profile and the roller, c = 0.2
+    hours, p_eq = _hand_l10_hours(cam, dyn.phi, dyn.contact_force, cam.roller_radius, flanks)
+    assert result.duty.roller.equivalent_load == pytest.approx(p_eq, rel=2e-4)
+    assert result.duty.roller.hours == pytest.approx(hours, rel=1e-3)
 
 
 def test_a_pairs_check_rows_name_the_second_plates_life_and_film(pair):
