@@ -27,7 +27,7 @@ from camcad.motion.program import Motion
 from camcad.motion.table import table_summary
 
 if TYPE_CHECKING:
-    from camcad.dynamics.duty import DutyResult
+    from camcad.dynamics.duty import DriveDuty, DutyResult
     from camcad.dynamics.vibration import VibrationResult
     from camcad.export.gcode import GcodeProgram
     from camcad.fea.results import FeaResult  # only typing: the FE package loads when the check runs
@@ -54,6 +54,12 @@ class PartResult:
         The certified NURBS of its further curves (``part.flanks``), in order; empty when not fitted.
     gcode
         Its program; None without a tool path, or when not made.
+    duty
+        Its roller's and track's life and its lubricant film (``[life]``,
+        ``[lubrication]``), by the same code for every part; None without either table.
+    fea
+        The finite-element check of a made plate (its own roller's contact
+        loads); None when not run, or for a part that is not a plate.
     """
 
     part: Part
@@ -62,11 +68,15 @@ class PartResult:
     fit: ProfileFit | None = None
     flank_fits: tuple[ProfileFit, ...] = ()
     gcode: GcodeProgram | None = None
+    duty: DutyResult | None = None
+    fea: FeaResult | None = None
 
     @property
     def findings(self) -> tuple[Finding, ...]:
-        """Its geometry's findings, its family checks' and its dynamics'; a later part's name theirs."""
-        found = (*self.geometry.findings, *self.part.findings, *self.dynamics.findings)
+        """Its geometry's, family checks', dynamics', FE's and duty's findings; a later part's name theirs."""
+        fea = self.fea.findings if self.fea is not None else ()
+        duty = self.duty.findings if self.duty is not None else ()
+        found = (*self.geometry.findings, *self.part.findings, *self.dynamics.findings, *fea, *duty)
         if not self.part.label:
             return found
         return tuple(replace(f, message=f"{self.part.label}: {f.message}") for f in found)
@@ -102,8 +112,7 @@ class Analysis:
     toolpath: Toolpath | None
     timings: dict[str, float] = field(default_factory=dict)
     stage_findings: tuple[Finding, ...] = ()
-    fea: FeaResult | None = None  # the finite-element check, when run ([fea] present, or asked for)
-    duty: DutyResult | None = None  # life, film and drive ([life], [lubrication], [drive]; issue 35)
+    drive: DriveDuty | None = None  # the follower train's drive ([drive]; issue 35)
     vibration: VibrationResult | None = None  # the elastic follower train ([vibration]; issue 34)
     _memo: dict[str, Any] = field(  # the motion summary, computed once (see summary)
         default_factory=dict, init=False, repr=False, compare=False
@@ -123,6 +132,16 @@ class Analysis:
     def dynamics(self) -> DynamicsResult:
         """The first part's contact force, torque, Hertz stress (over the same angles)."""
         return self.parts[0].dynamics
+
+    @property
+    def fea(self) -> FeaResult | None:
+        """The first plate's finite-element check, when run ([fea], or asked); each plate's in ``parts``."""
+        return self.parts[0].fea
+
+    @property
+    def duty(self) -> DutyResult | None:
+        """The first part's life and film ([life], [lubrication]; issue 35); every part's in ``parts``."""
+        return self.parts[0].duty
 
     @property
     def fit(self) -> ProfileFit | None:
@@ -146,6 +165,7 @@ class Analysis:
             *self.stage_findings,
             *(self.fea.findings if self.fea is not None else ()),
             *(self.duty.findings if self.duty is not None else ()),
+            *(self.drive.findings if self.drive is not None else ()),
             *(self.vibration.findings if self.vibration is not None else ()),
         )
         return tuple(sorted(found, key=lambda f: not f.hard))
@@ -155,6 +175,7 @@ class Analysis:
         """Every non-fatal message of every stage: soft findings and notes."""
         fea = list(self.fea.warnings) if self.fea is not None else []
         duty = [f.message for f in self.duty.findings] if self.duty is not None else []
+        duty += [f.message for f in self.drive.findings] if self.drive is not None else []
         vib = [f.message for f in self.vibration.findings if not f.hard] if self.vibration is not None else []
         return [*self.geometry.warnings, *self.dynamics.warnings, *fea, *duty, *vib]
 
@@ -187,7 +208,9 @@ class Analysis:
         if self.fea is not None:
             out["fea"] = self.fea.summary()
         if self.duty is not None:
-            out |= self.duty.summary()  # life, lubrication, drive
+            out |= self.duty.summary()  # the first part's life, lubrication (a later part's: its family's)
+        if self.drive is not None:
+            out |= self.drive.summary()  # the train's drive
         if self.vibration is not None:
             out["vibration"] = self.vibration.summary()
         out["warnings"] = self.warnings

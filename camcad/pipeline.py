@@ -23,6 +23,7 @@ from typing import Any
 from camcad.analysis import Analysis, PartResult, motion_summary
 from camcad.design import Design, load_design
 from camcad.dynamics import DynamicsResult, analyse_dynamics
+from camcad.dynamics.spec import DynamicsSetup
 from camcad.errors import DesignLimitError, ExportError, FitError, GougeError, UsageError
 from camcad.export.atomic import staged_folder
 from camcad.export.records import write_json, write_text
@@ -181,13 +182,16 @@ def analyse(
         raise DesignLimitError(hard[0].message)
     setup = design.dynamics_setup()
 
+    def setup_of(part: Part) -> DynamicsSetup:
+        # each part's own roller sets its Hertz contact (Johnson 1985, §4.3), its drive sign its force
+        return replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius)
+
     def dynamics_of(part: Part, geometry: GeometryAnalysis) -> DynamicsResult:
         return analyse_dynamics(
             part.cam.motion(geometry.phi),
             pressure_angle=geometry.pressure_angle,
             profile_rho=geometry.profile.rho,
-            # each part's own roller sets its Hertz contact (Johnson 1985, §4.3), its drive sign its force
-            setup=replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius),
+            setup=setup_of(part),
             cam=part.cam,
         )
 
@@ -201,24 +205,30 @@ def analyse(
         PartResult(part=part, geometry=g, dynamics=d)
         for part, g, d in zip(parts, geometries, dynamics, strict=True)
     ]
-    duty = None
+    drive = None
     if design.life is not None or design.lubrication is not None or design.drive is not None:
-        from camcad.dynamics.duty import analyse_duty
+        from camcad.dynamics.duty import analyse_duty, analyse_train_drive
 
-        duty = _timed(
-            timings,
-            progress,
-            "duty",
-            lambda: analyse_duty(
-                cam,
-                dynamics[0],
-                setup=setup,
-                profile=geometries[0].profile,
+        def duty_of(result: PartResult) -> PartResult:  # every part's life and film, by the same code
+            if design.life is None and design.lubrication is None:
+                return result
+            duty = analyse_duty(
+                result.part.cam,
+                result.dynamics,
+                setup=setup_of(result.part),
+                profile=result.geometry.profile,
                 life=design.life,
                 lubrication=design.lubrication,
-                drive=design.drive,
-            ),
-        )
+            )
+            return replace(result, duty=duty)
+
+        def duties() -> tuple[list[PartResult], Any]:
+            train = None  # the motor turns the camshaft: a figure of the train, not of a part
+            if design.drive is not None:
+                train = analyse_train_drive(cam, dynamics[0], setup=setup, spec=design.drive)
+            return [duty_of(r) for r in results], train
+
+        results, drive = _timed(timings, progress, "duty", duties)
     later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
     if fit and not hard:
         fit_curve = partial(
@@ -279,9 +289,9 @@ def analyse(
             results[index] = replace(result, gcode=render(plan, design.gcode.dialect))
         if spent:
             timings["toolpath"] = spent  # every part's plan
-    fea_result = None
     if fea and not hard:
-        fea_result = _timed(timings, progress, "fea", lambda: _fea_check(design, family, parts, dynamics[0]))
+        fea_setups = [setup_of(r.part) for r in results]
+        results = _timed(timings, progress, "fea", lambda: _fea_check(design, family, results, fea_setups))
     return Analysis(
         design=design,
         family=family,
@@ -290,8 +300,7 @@ def analyse(
         toolpath=planned,
         timings=timings,
         stage_findings=tuple(later),
-        fea=fea_result,
-        duty=duty,
+        drive=drive,
         vibration=vibration,
     )
 
@@ -319,18 +328,27 @@ def _labelled(part: Part, findings: Iterable[Finding]) -> list[Finding]:
     return [replace(f, message=f"{part.label}: {f.message}") for f in findings]
 
 
-def _fea_check(design: Design, family: CamFamily, parts: Sequence[Part], dynamics: DynamicsResult) -> Any:
-    """The FE check of a family's one plate with the design's ``[fea]`` table (its defaults when absent)."""
+def _fea_check(
+    design: Design, family: CamFamily, results: Sequence[PartResult], setups: Sequence[DynamicsSetup]
+) -> list[PartResult]:
+    """The FE check of every made plate with the design's ``[fea]`` table (its defaults when absent).
+
+    Each plate is loaded by its own roller's contact (its dynamics, its setup),
+    by the same code; a part that is not a plate cut along its outline (a
+    groove's blank) or not made is not checked.
+    """
     from camcad.fea import FeaSpec, analyse_fea
 
-    if len(parts) != 1 or parts[0].pocket is not None:  # the FE model is one plate cut along its outline
-        raise UsageError(
-            "fea", f"the finite-element check applies to cam.style = 'plate' only, not {family.name}"
-        )
+    if not family.plates:  # the FE model is a plate cut along its outline, held at its bore
+        raise UsageError("fea", f"the finite-element check applies to plate cams only, not {family.name}")
     spec = design.fea if design.fea is not None else FeaSpec()
-    return analyse_fea(
-        parts[0].cam, design.plate(), setup=design.dynamics_setup(), dynamics=dynamics, spec=spec
-    )
+    plate = design.plate()
+    return [
+        replace(r, fea=analyse_fea(r.part.cam, plate, setup=s, dynamics=r.dynamics, spec=spec))
+        if r.part.made and r.part.pocket is None
+        else r
+        for r, s in zip(results, setups, strict=True)
+    ]
 
 
 _STAGE_LIMITS: dict[str, tuple[type[DesignLimitError], str, str]] = {
@@ -632,8 +650,8 @@ def _write_files(
     if "fea" in groups and analysis.fea is not None:
         from camcad.export.stress import write_stress_vtu
 
-        fea = analysis.fea
-        stage("stress", lambda: write_stress_vtu(folder / "stress.vtu", fea))
+        checked = [(r.part.suffix, r.fea) for r in made if r.fea is not None]  # every made plate's
+        stage("stress", lambda: [write_stress_vtu(folder / f"stress{sfx}.vtu", f) for sfx, f in checked])
     return written
 
 
@@ -655,10 +673,11 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
 
     cam, design = analysis.cam, analysis.design
     unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
-    duty = analysis.duty.csv_columns() if analysis.duty is not None else None  # life, film, drive columns
+    duty = analysis.duty.csv_columns() if analysis.duty is not None else {}  # the first part's film
+    duty |= analysis.drive.csv_columns() if analysis.drive is not None else {}  # the train's motor torque
     motion_csv = write_motion_csv(folder / "motion.csv", cam, unit=unit)
     profile_csv = write_profile_csv(folder / "profile.csv", analysis.geometry)
-    dynamics_csv = write_dynamics_csv(folder / "dynamics.csv", analysis.dynamics, extra=duty)
+    dynamics_csv = write_dynamics_csv(folder / "dynamics.csv", analysis.dynamics, extra=duty or None)
     return [
         motion_csv,
         profile_csv,

@@ -442,12 +442,16 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str,
 # public API
 
 
-def _fea_section(analysis: Analysis) -> dict[str, Any] | None:
-    """The finite-element check (issue 22): a table of its load cases and a stress picture per case."""
-    fea = getattr(analysis, "fea", None)
-    if fea is None:
-        return None
+def _fea_section(analysis: Analysis) -> list[dict[str, Any]]:
+    """The finite-element check (issue 22) of every plate checked, by the same code (:func:`_fea_part`)."""
+    return [_fea_part(r.fea, r.part) for r in analysis.parts if r.fea is not None]
+
+
+def _fea_part(fea: Any, part: Any) -> dict[str, Any]:
+    """One plate's FE check: a table of its load cases and a stress picture per case."""
     from camcad.fea.plot import stress_figures
+
+    sfx = part.suffix
 
     rows = [
         [
@@ -464,10 +468,12 @@ def _fea_section(analysis: Analysis) -> dict[str, Any] | None:
     header = ["case", "load case", "φ [°]", "force [N]", "Hertz p0 [MPa]", "von Mises [MPa]", "where"]
     limit = "no allowable set" if fea.allowable_stress is None else f"allowable {fea.allowable_stress:g} MPa"
     figures = [
-        _figure(Plot(key=f"fea-{i}", title=title, caption=caption, png=png))
+        _figure(Plot(key=f"fea{sfx}-{i}", title=title, caption=caption, png=png))
         for i, (title, caption, png) in enumerate(stress_figures(fea), start=1)
     ]
     return {
+        "suffix": sfx,
+        "heading": part.title("Finite-element check"),
         "model": fea.plane.value.join(("Plane ", " model")),
         "nodes": len(fea.nodes),
         "cells": len(fea.cells),
@@ -480,8 +486,7 @@ def _fea_section(analysis: Analysis) -> dict[str, Any] | None:
 
 def _duty_section(analysis: Analysis) -> list[dict[str, Any]] | None:
     """Life, lubricant film and drive (issue 35): a figure each; their numbers are in the tables."""
-    duty = getattr(analysis, "duty", None)
-    if duty is None:
+    if analysis.duty is None and analysis.drive is None:
         return None
     from camcad._plots.duty import duty_plots
 

@@ -74,6 +74,12 @@ FAMILY_BRANCH = re.compile(
     r"|\.style\s+(?:is|==|!=)"  # a family told apart by comparing the style
     r"|\.style\.value\s*(?:==|!=)"
     r"|\bcamcad\.positive\b|\bfrom\s+camcad\s+import\s+positive\b"  # the second pipeline, gone
+    # a family told apart by the type of what it yields (a part's check, its family object)
+    r"|\bisinstance\([^)]*\b(?:Plate|Groove|Conjugate|Barrel|Linear)\w*"
+    r"|\btype\([^)]*\)\s*(?:is|==|!=)\s*(?:not\s+)?(?:Plate|Groove|Conjugate|Barrel|Linear)\w*"
+    # or by its registry entry or its name
+    r"|(?:\bis|==|!=)\s*(?:not\s+)?(?:PLATE|GROOVE|CONJUGATE|BARREL|LINEAR)\b"
+    r"|\bfamily\.name\s*(?:==|!=|in\b|not\s+in\b)"
 )
 KNOWN_FAMILY_BRANCHES: dict[str, str] = {}  # empty
 
@@ -242,12 +248,19 @@ def test_family_rule_flags_branches_and_the_second_pipeline():
         "camcad/c.py": "ok = spec.style.value == 'plate'\nx = CamStyle.CONJUGATE\n",
         "camcad/d.py": "family = family_of(design.cam.style)  # the registry: no branch\n",
         "camcad/e.py": "style: CamStyle = CamStyle.PLATE\nif cam.style is not CamStyle.PLATE:\n",
+        "camcad/f.py": "if isinstance(check, GrooveAnalysis):\n    pass\nok = isinstance(x, (int, float))\n",
+        "camcad/g.py": "if isinstance(fam, (PlateFamily, X)) or type(c) is ConjugateSpec:\n",
+        "camcad/h.py": "if family is GROOVE or analysis.family.name == 'barrel':\n",
+        "camcad/i.py": "margin = min(c.radius_margin for c in part.checks)  # data, no branch\n",
     }
     assert family_branches(sources) == {
         "camcad/a.py": ["if design.cam.style is CamStyle.GROOVE:"],
         "camcad/b.py": ["from camcad.positive import analyse_positive_drive"],
         "camcad/c.py": ["ok = spec.style.value == 'plate'", "x = CamStyle.CONJUGATE"],
         "camcad/e.py": ["if cam.style is not CamStyle.PLATE:"],
+        "camcad/f.py": ["if isinstance(check, GrooveAnalysis):"],
+        "camcad/g.py": ["if isinstance(fam, (PlateFamily, X)) or type(c) is ConjugateSpec:"],
+        "camcad/h.py": ["if family is GROOVE or analysis.family.name == 'barrel':"],
     }
 
 

@@ -1,8 +1,8 @@
 """The figures of life, lubricant film and drive (issue 35), one per analysis the design asks for.
 
-- life: the roller's load over the turn with its ISO 281 equivalent load P,
-  and the track's load-stress factor K when a K–N line is given;
-- film: the minimum film thickness and the film ratio λ with its limit;
+- life: each part's roller load over the turn with its ISO 281 equivalent
+  load P, and its track's load-stress factor K when a K–N line is given;
+- film: each part's minimum film thickness and film ratio λ with its limit;
 - drive: the motor torque over the turn with the motor's peak and rated
   torque, and the torque–speed plane with the motor's envelope.
 """
@@ -19,6 +19,7 @@ from camcad._plots.chart import HLine, Panel, Series, line_chart
 
 if TYPE_CHECKING:
     from camcad.analysis import Analysis
+    from camcad.dynamics.duty import DutyResult
 
 __all__ = ["drive_plots", "duty_plots", "film_plot", "life_plot"]
 
@@ -32,44 +33,73 @@ def _series(phi_deg: np.ndarray, values: object, color: str, label: str = "") ->
     return Series(x=x, y=y, color=color, label=label)
 
 
+def _parts(analysis: Analysis) -> list[tuple[str, np.ndarray, DutyResult]]:
+    """Every part's curves' label ("plate 2" beside "plate 1"; none for one part), angles [deg] and duty."""
+    duties = [(np.degrees(r.dynamics.phi), r.duty) for r in analysis.parts if r.duty is not None]
+    if len(duties) == 1:
+        return [("", *duties[0])]
+    return [(f"plate {i}", phi, d) for i, (phi, d) in enumerate(duties, start=1)]
+
+
+def _named(label: str, text: str) -> str:
+    return f"{label}: {text}" if label else text
+
+
 def life_plot(analysis: Analysis) -> Plot | None:
-    """The roller's load over the turn against its equivalent load; the track's K when given."""
-    duty = analysis.duty
-    if duty is None or duty.life is None:
+    """Each part's roller load over the turn against its equivalent load; its track's K when given."""
+    parts = _parts(analysis)
+    if not parts or parts[0][2].life is None:
         return None
-    phi = np.degrees(analysis.dynamics.phi)
     panels = []
     notes = []
-    if duty.roller is not None:
-        load = np.abs(np.asarray(analysis.dynamics.contact_force, dtype=float))
-        p = duty.roller.equivalent_load
+    rollers = [(label, phi, d) for label, phi, d in parts if d.roller is not None]
+    if rollers:
+        series = [
+            _series(phi, d.load, COLORS[4] if k == 0 else COLORS[1], label or "roller load")
+            for k, (label, phi, d) in enumerate(rollers)
+        ]
+        lines = []
+        for k, (label, _, d) in enumerate(rollers):
+            assert d.roller is not None
+            p = d.roller.equivalent_load
+            lines.append(
+                HLine(
+                    y=p,
+                    color=COLORS[1] if k == 0 else COLORS[4],
+                    label=_named(label, f"equivalent load P = {p:.1f} N (ISO 281)"),
+                )
+            )
+            notes.append(
+                _named(
+                    label,
+                    f"L10 = (C/P)^p = {d.roller.l10_million_revolutions:.4g} million roller turns, "
+                    f"{d.roller.hours:.4g} h at {d.roller.turns_per_cam_turn:.3f} roller turns a cam turn",
+                )
+            )
         panels.append(
             Panel(
-                ylabel="roller load\n|F| [N]",
-                series=[_series(phi, load, COLORS[4], "roller load")],
-                lines=[HLine(y=p, color=COLORS[1], label=f"equivalent load P = {p:.1f} N (ISO 281)")],
+                ylabel="roller load\n[N]",
+                series=series,
+                lines=lines,
                 legend=True,
                 height=140.0,
             )
         )
-        notes.append(
-            f"L10 = (C/P)^p = {duty.roller.l10_million_revolutions:.4g} million roller turns, "
-            f"{duty.roller.hours:.4g} h at {duty.roller.turns_per_cam_turn:.3f} roller turns a cam turn"
-        )
-    if duty.track is not None:
-        panels.append(
-            Panel(
-                ylabel="load-stress\nfactor K [MPa]",
-                series=[_series(phi, duty.track.factor, COLORS[6], "K = (F/L)(1/R₁ + 1/R₂)")],
-                legend=True,
-                height=140.0,
+    tracks = [(label, phi, d) for label, phi, d in parts if d.track is not None]
+    if tracks:
+        series = []
+        for k, (label, phi, d) in enumerate(tracks):
+            assert d.track is not None
+            name = _named(label, "K = (F/L)(1/R₁ + 1/R₂)")
+            series.append(_series(phi, d.track.factor, COLORS[6] if k == 0 else COLORS[1], name))
+            notes.append(
+                _named(
+                    label, f"track life {d.track.hours:.4g} h at the largest K ({d.track.factor_max:.4g} MPa)"
+                )
             )
-        )
-        notes.append(
-            f"track life {duty.track.hours:.4g} h at the largest K ({duty.track.factor_max:.4g} MPa)"
-        )
+        panels.append(Panel(ylabel="load-stress\nfactor K [MPa]", series=series, legend=True, height=140.0))
     if not panels:
-        sliding = float(np.max(duty.contact.sliding_speed))
+        sliding = float(np.max(parts[0][2].contact.sliding_speed))
         return Plot(
             key="life",
             title="Life",
@@ -85,22 +115,38 @@ def life_plot(analysis: Analysis) -> Plot | None:
 
 
 def film_plot(analysis: Analysis) -> Plot | None:
-    """Minimum film thickness and film ratio λ over the turn, λ's limit dashed."""
-    duty = analysis.duty
-    if duty is None or duty.film is None:
+    """Each part's minimum film thickness and film ratio λ over the turn, λ's limit dashed."""
+    films = [(label, d.film) for label, _, d in _parts(analysis) if d.film is not None]
+    if not films:
         return None
-    film = duty.film
-    phi = np.degrees(film.phi)
-    shown_h = np.where(np.isfinite(film.thickness_um), film.thickness_um, np.nan)
-    shown_l = np.where(np.isfinite(film.ratio), film.ratio, np.nan)
-    top = float(np.nanmax(shown_l)) if np.isfinite(shown_l).any() else film.limit
+    limit = films[0][1].limit
+    thickness, ratio, notes = [], [], []
+    top = limit
+    for k, (label, film) in enumerate(films):
+        phi = np.degrees(film.phi)
+        shown_h = np.where(np.isfinite(film.thickness_um), film.thickness_um, np.nan)
+        shown_l = np.where(np.isfinite(film.ratio), film.ratio, np.nan)
+        if np.isfinite(shown_l).any():
+            top = max(top, float(np.nanmax(shown_l)))
+        thickness.append(_series(phi, shown_h, COLORS[0] if k == 0 else COLORS[1], label))
+        ratio.append(
+            _series(phi, shown_l, COLORS[2] if k == 0 else COLORS[1], label or "λ = h_min/√(Rq₁² + Rq₂²)")
+        )
+        where = "" if film.flank is None else f", {film.flank} flank"
+        notes.append(
+            _named(
+                label,
+                f"smallest λ {film.min_ratio:.3g} at φ = {math.degrees(film.angle):.1f}°{where} "
+                f"(h_min {film.min_thickness_um:.3g} µm)",
+            )
+        )
     panels = [
-        Panel(ylabel="film h_min\n[µm]", series=[_series(phi, shown_h, COLORS[0])], height=130.0),
+        Panel(ylabel="film h_min\n[µm]", series=thickness, legend=len(films) > 1, height=130.0),
         Panel(
             ylabel="film ratio λ",
-            series=[_series(phi, shown_l, COLORS[2], "λ = h_min/√(Rq₁² + Rq₂²)")],
-            lines=[HLine(y=film.limit, label=f"min_film_ratio {film.limit:g}")],
-            ylim=(0.0, max(top, film.limit) * 1.1),
+            series=ratio,
+            lines=[HLine(y=limit, label=f"min_film_ratio {limit:g}")],
+            ylim=(0.0, top * 1.1),
             legend=True,
             height=130.0,
         ),
@@ -108,20 +154,18 @@ def film_plot(analysis: Analysis) -> Plot | None:
     return Plot(
         key="film",
         title="Lubricant film",
-        caption=f"Dowson–Higginson minimum film thickness of the line contact; smallest λ "
-        f"{film.min_ratio:.3g} at φ = {math.degrees(film.angle):.1f}° "
-        f"(h_min {film.min_thickness_um:.3g} µm). "
-        "Gaps: no contact.",
+        caption="Dowson–Higginson minimum film thickness of the line contact; "
+        + "; ".join(notes)
+        + ". Gaps: no contact.",
         svg=line_chart(panels, bounds_deg=_bounds(analysis), title="Lubricant film"),
     )
 
 
 def drive_plots(analysis: Analysis) -> list[Plot]:
     """Motor torque over the turn, and the torque–speed plane with the motor's envelope."""
-    duty = analysis.duty
-    if duty is None or duty.drive is None:
+    if analysis.drive is None:
         return []
-    drive, spec = duty.drive, analysis.design.drive
+    drive, spec = analysis.drive.drive, analysis.design.drive
     assert spec is not None
     phi = np.degrees(drive.phi)
     lines = [HLine(y=drive.rms_torque, color=COLORS[1], dash="2 3", label=f"RMS {drive.rms_torque:.3g} N·m")]

@@ -63,11 +63,19 @@ def _cmd_check(args: argparse.Namespace) -> int:
     design = load_design(args.design)
     # check does not depend on the [gcode] options: it plans no toolpath (build does)
     analysis = analyse(design, strict=False, toolpath=False, fea=args.fea or design.fea is not None)
-    rows = _check_rows(analysis.summary(), design) + _positive_rows(analysis.summary())
+    positive = analysis.dynamics.positive_drive  # the family holds the follower on both ways (its Drive)
+    rows = _check_rows(analysis.summary(), design, positive_drive=positive)
+    rows += _positive_rows(analysis.summary(), positive_drive=positive)
     rows += _duty_rows(analysis.summary())
+    for later in analysis.parts[1:]:  # every further part's life and film (its own roller), the same rows
+        if later.duty is not None:
+            rows += _duty_rows(later.duty.summary(), f"{later.part.label} ")
     rows += _vibration_rows(analysis.summary())
     if analysis.fea is not None:
         rows += _fea_rows(analysis.summary()["fea"])
+    for later in analysis.parts[1:]:  # every further plate's FE check, the same rows
+        if later.fea is not None:
+            rows += _fea_rows(later.fea.summary(), f"{later.part.label} ")
     width = max(len(k) for k, _ in rows)
     print(f"{design.cam.name} ({args.design})")
     for key, value in rows:

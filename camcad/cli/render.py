@@ -37,7 +37,8 @@ def _lift_row(motion: dict[str, Any]) -> tuple[str, str]:
     return name, text
 
 
-def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
+def _check_rows(summary: dict[str, Any], design: Any, *, positive_drive: bool) -> list[tuple[str, str]]:
+    """The common rows of ``camcad check``; ``positive_drive``: the family drives the follower both ways."""
     geo, dyn = summary["geometry"], summary["dynamics"]
     fit = summary.get("fit") or {}
     limit = math.degrees(design.cam.max_pressure_angle)
@@ -71,7 +72,7 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
         ),
         (
             "follower jump",
-            "none (positive drive)" if {"groove", "second_plate"} & set(summary) else _fmt(dyn.get("jump")),
+            "none (positive drive)" if positive_drive else _fmt(dyn.get("jump")),
         ),
         (
             "fit control points",
@@ -80,19 +81,26 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
     ]
 
 
-def _duty_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
-    """The rows ``[life]``, ``[lubrication]`` and ``[drive]`` add to ``camcad check`` (issue 35)."""
+def _duty_rows(summary: dict[str, Any], prefix: str = "") -> list[tuple[str, str]]:
+    """The rows ``[life]``, ``[lubrication]`` and ``[drive]`` add to ``camcad check`` (issue 35).
+
+    ``summary`` is ``summary.json`` or a later part's own sections (its duty's
+    summary), whose rows start with ``prefix``: the same rows for every part.
+    """
     rows: list[tuple[str, str]] = []
     life, film, drive = summary.get("life"), summary.get("lubrication"), summary.get("drive")
     if life is not None and "sliding_speed_max_mm_per_s" in life:
         rows.append(
-            ("rolling life", f"n/a: the face slides (max {life['sliding_speed_max_mm_per_s']:.1f} mm/s)")
+            (
+                f"{prefix}rolling life",
+                f"n/a: the face slides (max {life['sliding_speed_max_mm_per_s']:.1f} mm/s)",
+            )
         )
     if life is not None and "roller_life_h" in life:
         hours = life["roller_life_h"]
         rows.append(
             (
-                "roller L10 life",
+                f"{prefix}roller L10 life",
                 ("unloaded" if hours is None else f"{hours:.4g} h")
                 + f" (P {life['roller_equivalent_load_N']:.1f} N,"
                 + f" {life['roller_turns_per_cam_turn']:.3f} roller turns a turn)",
@@ -100,13 +108,21 @@ def _duty_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
         )
     if life is not None and "track_life_h" in life:
         hours = life["track_life_h"]
-        rows.append(("track life", "unloaded" if hours is None else f"{hours:.4g} h"))
-    if film is not None:
+        flank = life.get("track_load_stress_factor_flank")  # a groove: the flank that fails first
         rows.append(
             (
-                "min film ratio λ",
+                f"{prefix}track life",
+                ("unloaded" if hours is None else f"{hours:.4g} h") + (f" ({flank} flank)" if flank else ""),
+            )
+        )
+    if film is not None:
+        flank = film.get("min_film_ratio_flank")
+        rows.append(
+            (
+                f"{prefix}min film ratio λ",
                 _fmt(film["min_film_ratio"], "", 2)
                 + _at(film, "min_film_ratio")
+                + (f", {flank} flank" if flank else "")
                 + f" (limit {film['film_ratio_limit']:g})",
             )
         )
@@ -157,7 +173,7 @@ def _vibration_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     return rows
 
 
-def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+def _positive_rows(summary: dict[str, Any], *, positive_drive: bool) -> list[tuple[str, str]]:
     """The rows a groove or a conjugate pair adds to ``camcad check``: flanks, second plate, crossovers."""
     rows: list[tuple[str, str]] = []
     groove, second = summary.get("groove"), summary.get("second_plate")
@@ -201,7 +217,7 @@ def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
                 _fmt(dyn2.get("hertz_stress_max_MPa"), " MPa", 1) + _at(dyn2, "hertz_stress_max"),
             ),
         ]
-    if groove is not None or second is not None:
+    if positive_drive:
         dyn = summary["dynamics"]
         crossings = ", ".join(f"{a:.1f}°" for a in dyn.get("crossover_angles_deg", [])) or "none"
         rows.append(("crossovers", crossings))
@@ -210,17 +226,20 @@ def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     return rows
 
 
-def _fea_rows(fea: dict[str, Any]) -> list[tuple[str, str]]:
-    """The finite-element check's rows of ``camcad check``: the peak von Mises stress, then each case."""
+def _fea_rows(fea: dict[str, Any], prefix: str = "") -> list[tuple[str, str]]:
+    """The finite-element check's rows of ``camcad check``: the peak von Mises stress, then each case.
+
+    ``prefix`` names a later plate's rows ("second plate "): the same rows for every plate.
+    """
     limit = fea.get("allowable_stress_MPa")
     peak = _fmt(fea.get("von_mises_max_MPa"), " MPa", 1)
     if fea.get("von_mises_max_angle_deg") is not None:
         peak += f" at {fea['von_mises_max_angle_deg']:.1f}°, {fea['von_mises_max_where']}"
-    rows = [("FE max von Mises", peak + (f" (limit {limit:g} MPa)" if limit is not None else ""))]
+    rows = [(f"{prefix}FE max von Mises", peak + (f" (limit {limit:g} MPa)" if limit is not None else ""))]
     for case in fea.get("cases", []):
         rows.append(
             (
-                f"  FE case {case['case']}",
+                f"  {prefix}FE case {case['case']}",
                 f"{case['label']} at {case['angle_deg']:.1f}°: von Mises {case['von_mises_max_MPa']:.1f} MPa "
                 f"(Hertz {case['hertz_stress_MPa']:.1f} MPa)",
             )

@@ -21,7 +21,7 @@ from camcad.dynamics.drive import DriveMode
 from camcad.dynamics.spec import DynamicsModel
 from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
-from camcad.geometry.families import family_of
+from camcad.geometry.families import FAMILIES, family_of
 from camcad.geometry.followers import (
     FOLLOWER_TYPES,
     FollowerType,
@@ -255,9 +255,14 @@ def _check_fea(design: Design) -> None:
     from camcad.fea.mesh import MAX_ELEMENTS, estimated_triangles, smallest_mesh_size
     from camcad.fea.model import keyway_fillet
 
-    if not family_of(design.cam.style).one_plate:
-        style = design.cam.style.value
-        raise DesignError("fea", f"the finite-element check applies to cam.style = 'plate' only, not {style}")
+    if not family_of(design.cam.style).plates:
+        style, allowed = (
+            design.cam.style.value,
+            " or ".join(repr(s.value) for s, f in FAMILIES.items() if f.plates),
+        )
+        raise DesignError(
+            "fea", f"the finite-element check applies to cam.style = {allowed} only, not {style}"
+        )
     bore = design.plate().bore
     if bore is None:
         raise DesignError(

@@ -16,6 +16,7 @@ from camcad._typing import ArrayLike, FloatArray, readonly
 
 __all__ = [
     "contact_curvature",
+    "driving_curvature",
     "effective_modulus",
     "hertz_half_width",
     "hertz_stress",
@@ -82,6 +83,47 @@ def contact_curvature(profile_rho: ArrayLike, *, roller_radius: float | None) ->
     if roller_radius:
         kappa = kappa + 1.0 / roller_radius  # Johnson 1985, §4.3: 1/R = 1/R1 + 1/R2
     out = np.where(kappa > 0.0, kappa, 0.0)
+    readonly(out)
+    return out
+
+
+def driving_curvature(
+    profile_rho: ArrayLike,
+    force: ArrayLike,
+    *,
+    roller_radius: float | None,
+    flank_offsets: tuple[float, float] | None = None,
+) -> FloatArray:
+    """The relative curvature 1/R* [1/mm] of the surface that carries the contact, every part alike.
+
+    Parameters
+    ----------
+    profile_rho
+        (n,) signed radius of curvature of the part's cam profile [mm] (positive convex).
+    force
+        (n,) the part's contact force F [N]; a groove's inner flank drives where F ≥ 0, its outer
+        flank where F < 0.
+    roller_radius
+        r_f [mm]; None or 0 for a flat face.
+    flank_offsets
+        A groove's (inner, outer) flanks as offsets d of the profile [mm]
+        (:func:`camcad.geometry.groove.flank_offsets`); None: the profile carries the contact.
+
+    Returns
+    -------
+    FloatArray
+        (n,) 1/R* (:func:`contact_curvature`). A groove's inner flank, radius ρ + d_inner, has the
+        roller outside it; the outer flank, radius ρ + d_outer, has the roller inside it, so the
+        roller sees it concave, radius −(ρ + d_outer): 1/R* = 1/r_f − 1/(ρ + d_outer)
+        (Johnson 1985, §4.3, a concave surface's radius negative).
+    """
+    rho = np.asarray(profile_rho, dtype=float)
+    roller = roller_radius or None
+    if flank_offsets is None:
+        return contact_curvature(rho, roller_radius=roller)
+    inner = contact_curvature(rho + flank_offsets[0], roller_radius=roller)
+    outer = contact_curvature(-(rho + flank_offsets[1]), roller_radius=roller)  # Johnson 1985, §4.3
+    out: FloatArray = np.where(np.asarray(force, dtype=float) >= 0.0, inner, outer)
     readonly(out)
     return out
 

@@ -1,20 +1,25 @@
-"""Will it run and last: life, lubricant film and drive of one cam from its rigid dynamics.
+"""Will it run and last: life and lubricant film of each part, and the drive of the follower train.
 
-:func:`analyse_duty` runs the analyses a design asks for (``[life]``,
-``[lubrication]``, ``[drive]``) on the samples of the rigid dynamics, so
-they cost one more profile evaluation and a few array operations:
+:func:`analyse_duty` runs the analyses of one part of a cam family
+(``[life]``, ``[lubrication]``) on the samples of its rigid dynamics, by the
+same code for every part, so they cost one more profile evaluation and a few
+array operations:
 
-- the contact's speeds (:func:`camcad.dynamics.rolling.contact_motion`);
+- the contact's speeds (:func:`camcad.dynamics.rolling.contact_motion`) over
+  the surface that carries it;
 - the roller's L10 and the track's K–N life (:mod:`camcad.dynamics.life`),
   or, for a face that slides, its sliding speed instead;
-- the film thickness and film ratio (:mod:`camcad.dynamics.film`);
-- the motor's duty and the laws' VDI 2143 characteristic values
-  (:mod:`camcad.dynamics.drive`).
+- the film thickness and film ratio (:mod:`camcad.dynamics.film`).
 
-The plate's profile carries the contact where the contact force is
-positive; a groove's other flank (or a conjugate pair's second plate), which
-carries it where the force is negative, is not analysed for film and track
-life (its roller is: the roller's load is |F|).
+A part carries the contact where its contact force is positive (its
+``drive_sign`` turns the force of a conjugate pair's second plate, whose own
+roller then sets its curvature, speed and life). A groove's one part carries
+it on both flanks: the inner where F ≥ 0, the outer, with its own curvature
+and arc speed, where F < 0 (:func:`carried_contact`).
+
+:func:`analyse_train_drive` sizes the motor (:mod:`camcad.dynamics.drive`)
+and gives the laws' VDI 2143 characteristic values: figures of the follower
+train (the camshaft torque is the same whichever part drives), once per design.
 """
 
 from __future__ import annotations
@@ -25,11 +30,12 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
-from camcad._typing import FloatArray
+from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
 from camcad.dynamics.arm import arm_speed
-from camcad.dynamics.contact import contact_curvature, effective_modulus
+from camcad.dynamics.contact import driving_curvature, effective_modulus
 from camcad.dynamics.drive import (
     CharacteristicValues,
     DriveMode,
@@ -59,6 +65,7 @@ from camcad.dynamics.life import (
     track_life,
 )
 from camcad.dynamics.model import _arm_load, _model
+from camcad.dynamics.results import FLANK_WORDS
 from camcad.dynamics.rolling import ContactMotion, contact_motion
 from camcad.dynamics.spring import spring_from_spec
 from camcad.extremes import Side, maximum, minimum
@@ -67,77 +74,209 @@ from camcad.findings import Finding
 if TYPE_CHECKING:
     from camcad.dynamics.results import DynamicsResult
     from camcad.dynamics.spec import DynamicsSetup
-    from camcad.geometry.cam import Cam, CamState
+    from camcad.geometry.cam import Cam
     from camcad.geometry.curves import CurveSample
+    from camcad.motion.program import Motion
 
-__all__ = ["DutyResult", "analyse_duty"]
+__all__ = [
+    "CarriedContact",
+    "DriveDuty",
+    "DutyResult",
+    "analyse_duty",
+    "analyse_train_drive",
+    "carried_contact",
+]
 
 _MM2_PER_M2 = 1e6
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class CarriedContact:
+    """The contact as the part's surface carries it, arrays (n,) over the cam angles.
+
+    Attributes
+    ----------
+    load
+        The force the part's surface carries [N]: F where F > 0 (the other
+        part, or nothing, carries it elsewhere), |F| on a groove's two flanks.
+    curvature
+        The carrying surface's relative curvature 1/R* [1/mm]
+        (:func:`~camcad.dynamics.contact.driving_curvature`).
+    motion
+        The contact's speeds over the carrying surface.
+    outer
+        A groove's (n,) mask where its outer flank carries the contact, else None.
+    """
+
+    load: FloatArray
+    curvature: FloatArray
+    motion: ContactMotion
+    outer: npt.NDArray[np.bool_] | None = None
+
+    def flank_at(self, i: int) -> str | None:
+        """The groove flank that carries sample ``i`` (``"inner"``/``"outer"``), else None."""
+        return None if self.outer is None else FLANK_WORDS[int(bool(self.outer[i]))]
+
+
+def carried_contact(
+    cam: Cam,
+    phi: FloatArray,
+    force: ArrayLike,
+    *,
+    setup: DynamicsSetup,
+    profile: CurveSample,
+    motion: Motion | None = None,
+    side: Side = "right",
+) -> CarriedContact:
+    """Load, curvature and speeds of the contact on the surface of the part that carries it.
+
+    Parameters
+    ----------
+    cam
+        The part's exact cam (its own roller).
+    phi
+        (n,) cam angles [rad].
+    force
+        (n,) the part's contact force F [N] (its drive sign applied).
+    setup
+        The part's dynamics setup (its ``roller_radius``, a groove's ``flank_offsets``).
+    profile
+        ``cam.profile(phi)``.
+    motion
+        ``cam.motion(phi)`` if already computed.
+    side
+        The one-sided limit at joints (for a groove's flanks).
+
+    Returns
+    -------
+    CarriedContact
+        Without flanks the profile carries the contact where F > 0. On a
+        groove the flank offset d of the profile carries it (inner where
+        F ≥ 0, outer where F < 0): its speeds are those of ``cam.offset(φ, d)``
+        (in pure rolling u = w, the speed at which the contact runs over that flank).
+    """
+    f = np.asarray(force, dtype=float)
+    curvature = driving_curvature(
+        profile.rho, f, roller_radius=setup.roller_radius, flank_offsets=setup.flank_offsets
+    )
+    if setup.flank_offsets is None:
+        contact = contact_motion(cam, phi, omega=setup.omega, profile=profile, motion=motion)
+        load = np.clip(f, 0.0, None)
+        readonly(load)
+        return CarriedContact(load=load, curvature=curvature, motion=contact)
+    inner_at, outer_at = setup.flank_offsets
+    inner, outer = (
+        contact_motion(cam, phi, omega=setup.omega, profile=cam.offset(phi, d, side=side), motion=motion)
+        for d in (inner_at, outer_at)
+    )
+    on_outer = f < 0.0
+
+    def pick(a: FloatArray, b: FloatArray) -> FloatArray:
+        out: FloatArray = np.where(on_outer, b, a)
+        readonly(out)
+        return out
+
+    contact = ContactMotion(
+        arc_speed=pick(inner.arc_speed, outer.arc_speed),
+        contact_speed=pick(np.abs(inner.contact_speed), np.abs(outer.contact_speed)),
+        slip=pick(inner.slip, outer.slip),
+        sliding_speed=pick(inner.sliding_speed, outer.sliding_speed),
+        entraining_speed=pick(inner.entraining_speed, outer.entraining_speed),
+        rolling=inner.rolling,
+    )
+    load = np.abs(f)
+    readonly(load)
+    on_outer.flags.writeable = False
+    return CarriedContact(load=load, curvature=curvature, motion=contact, outer=on_outer)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class DutyResult:
-    """Life, film and drive of one cam.
+    """Life and lubricant film of one part.
 
     Attributes
     ----------
     contact
-        The contact's speeds over the turn.
+        The contact's speeds over the turn, over the surface that carries it.
+    load
+        (n,) the force the part's surface and roller carry [N] (:attr:`CarriedContact.load`).
     roller, track
-        The roller's and the track's lives, or ``None`` (no ``[life]``, a
+        The part's roller's and track's lives, or ``None`` (no ``[life]``, a
         sliding face, or no rating / material given).
+    life
+        The ``[life]`` table, or ``None``.
     film
         The film over the turn, or ``None`` without ``[lubrication]``.
-    drive
-        The motor's duty, or ``None`` without ``[drive]``.
-    characteristics
-        VDI 2143 values of every rise and return (with ``[drive]``).
     findings
-        Every soft finding of the three analyses.
+        Every soft finding of the two analyses.
     """
 
     contact: ContactMotion
+    load: FloatArray
     roller: RollerLife | None = None
     track: TrackLife | None = None
     life: LifeSpec | None = None
     film: FilmResult | None = None
-    drive: DriveResult | None = None
-    characteristics: tuple[tuple[int, str, CharacteristicValues], ...] = ()
     findings: tuple[Finding, ...] = ()
 
     def summary(self) -> dict[str, Any]:
-        """The ``life``, ``lubrication`` and ``drive`` sections of ``summary.json`` (those computed)."""
+        """The ``life`` and ``lubrication`` sections of ``summary.json`` (those computed)."""
         out: dict[str, Any] = {}
         if self.life is not None:
             sliding = None if self.contact.rolling else float(np.max(self.contact.sliding_speed))
             out["life"] = summary_entry(self.roller, self.track, sliding_max=sliding)
         if self.film is not None:
             out["lubrication"] = self.film.summary()
-        if self.drive is not None:
-            drive = self.drive.summary()
-            drive["characteristic_values"] = [
-                {
-                    "segment": index,
-                    "law": law,
-                    "C_v": cv.c_v,
-                    "C_a": cv.c_a,
-                    "C_j": cv.c_j,
-                    "C_Mdyn": cv.c_mdyn,
-                }
-                for index, law, cv in self.characteristics
-            ]
-            out["drive"] = drive
         return out
 
     def csv_columns(self) -> dict[str, FloatArray]:
-        """Extra ``dynamics.csv`` columns: film thickness [µm], λ, motor torque [N·m] (those computed)."""
+        """Extra ``dynamics.csv`` columns: film thickness [µm] and λ (with ``[lubrication]``)."""
         out: dict[str, FloatArray] = {}
         if self.film is not None:
             out["film_thickness_um"] = self.film.thickness_um
             out["film_ratio"] = self.film.ratio
-        if self.drive is not None:
-            out["motor_torque_Nm"] = self.drive.motor_torque
         return out
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DriveDuty:
+    """The drive of the follower train: the motor's duty and the laws' VDI 2143 values.
+
+    Attributes
+    ----------
+    drive
+        The motor's duty.
+    characteristics
+        VDI 2143 values of every rise and return.
+    """
+
+    drive: DriveResult
+    characteristics: tuple[tuple[int, str, CharacteristicValues], ...] = ()
+
+    @property
+    def findings(self) -> tuple[Finding, ...]:
+        """The drive's soft findings."""
+        return self.drive.findings
+
+    def summary(self) -> dict[str, Any]:
+        """The ``drive`` section of ``summary.json``."""
+        drive = self.drive.summary()
+        drive["characteristic_values"] = [
+            {
+                "segment": index,
+                "law": law,
+                "C_v": cv.c_v,
+                "C_a": cv.c_a,
+                "C_j": cv.c_j,
+                "C_Mdyn": cv.c_mdyn,
+            }
+            for index, law, cv in self.characteristics
+        ]
+        return {"drive": drive}
+
+    def csv_columns(self) -> dict[str, FloatArray]:
+        """The extra ``dynamics.csv`` column: motor torque [N·m]."""
+        return {"motor_torque_Nm": self.drive.motor_torque}
 
 
 def analyse_duty(
@@ -148,22 +287,22 @@ def analyse_duty(
     profile: CurveSample,
     life: LifeSpec | None = None,
     lubrication: LubricationSpec | None = None,
-    drive: DriveSpec | None = None,
 ) -> DutyResult:
-    """Roller and track life, lubricant film and drive over the samples of the rigid dynamics.
+    """Roller and track life and lubricant film of one part, over the samples of its rigid dynamics.
 
     Parameters
     ----------
     cam
-        The exact cam.
+        The part's exact cam (its own follower and roller).
     dynamics
-        The rigid dynamics over ``dynamics.phi``.
+        The part's rigid dynamics over ``dynamics.phi`` (its drive sign applied).
     setup
-        The dynamics stage's options (speed, contact length, materials).
+        The part's dynamics options (speed, contact length, materials, its
+        roller radius and drive sign, a groove's flank offsets).
     profile
-        The cam profile at ``dynamics.phi`` (the geometry stage's).
-    life, lubrication, drive
-        The design's ``[life]``, ``[lubrication]`` and ``[drive]`` tables, or ``None``.
+        The part's cam profile at ``dynamics.phi`` (the geometry stage's).
+    life, lubrication
+        The design's ``[life]`` and ``[lubrication]`` tables, or ``None``.
 
     Returns
     -------
@@ -172,9 +311,8 @@ def analyse_duty(
     phi = dynamics.phi
     omega = setup.omega
     motion = cam.motion(phi)
-    contact = contact_motion(cam, phi, omega=omega, profile=profile, motion=motion)
-    curvature = contact_curvature(profile.rho, roller_radius=setup.roller_radius or None)
-    force = np.asarray(dynamics.contact_force, dtype=float)
+    carried = carried_contact(cam, phi, dynamics.contact_force, setup=setup, profile=profile, motion=motion)
+    contact = carried.motion
     dyn = setup.spec
     findings: list[Finding] = []
     roller = track = None
@@ -182,7 +320,7 @@ def analyse_duty(
         if contact.rolling and life.roller_dynamic_load_rating is not None:
             roller = roller_life(
                 phi,
-                np.abs(force),  # a groove's roller carries |F| on either flank
+                carried.load,  # the load on the part's own roller
                 contact.arc_speed,
                 roller_radius=setup.roller_radius,
                 omega=omega,
@@ -190,8 +328,14 @@ def analyse_duty(
             )
         if life.track is not None:
             track = track_life(
-                phi, force, curvature=curvature, length=setup.contact_length, omega=omega, spec=life
+                phi,
+                carried.load,
+                curvature=carried.curvature,
+                length=setup.contact_length,
+                omega=omega,
+                spec=life,
             )
+            track = replace(track, flank=carried.flank_at(int(np.argmax(track.factor))))
             track = _exact_track(cam, setup, phi, track, life)
         findings += life_findings(life, roller=roller, track=track)
     film = None
@@ -204,30 +348,38 @@ def analyse_duty(
         )
         film = analyse_film(
             phi,
-            force,
-            curvature=curvature,
+            carried.load,
+            curvature=carried.curvature,
             length=setup.contact_length,
             speed=contact.entraining_speed,
             contact_modulus=modulus,
             spec=lubrication,
         )
+        film = replace(film, flank=carried.flank_at(int(np.argmin(film.ratio))))
         film = _exact_film(cam, setup, film, lubrication, modulus)
         findings += film.findings
-    result = None
-    characteristics: tuple[tuple[int, str, CharacteristicValues], ...] = ()
-    if drive is not None:
-        result = _drive(cam, dynamics, setup=setup, spec=drive)
-        characteristics = segment_characteristics(cam.program)
-        findings += result.findings
     return DutyResult(
         contact=contact,
+        load=carried.load,
         roller=roller,
         track=track,
         life=life,
         film=film,
-        drive=result,
-        characteristics=characteristics,
         findings=tuple(findings),
+    )
+
+
+def analyse_train_drive(
+    cam: Cam, dynamics: DynamicsResult, *, setup: DynamicsSetup, spec: DriveSpec
+) -> DriveDuty:
+    """The motor's duty and the laws' VDI 2143 values: figures of the follower train, not of a part.
+
+    ``dynamics`` is any part's (the camshaft torque is the same whichever part
+    drives); ``setup`` the design's dynamics options.
+    """
+    return DriveDuty(
+        drive=_drive(cam, dynamics, setup=setup, spec=spec),
+        characteristics=segment_characteristics(cam.program),
     )
 
 
@@ -235,13 +387,14 @@ def _joints(cam: Cam) -> list[float]:
     return [bp.phi for bp in cam.program.breakpoints]
 
 
-def _pointwise(cam: Cam, setup: DynamicsSetup) -> Callable[[FloatArray, Side], tuple[CamState, FloatArray]]:
-    """The exact cam state and contact force at any angles (the rigid model, one-sided at joints)."""
+def _carried_at(cam: Cam, setup: DynamicsSetup) -> Callable[[FloatArray, Side], CarriedContact]:
+    """The exact contact the part carries at any angles (the rigid model, one-sided at joints)."""
     model = _model(setup)
 
-    def at(p: FloatArray, side: Side) -> tuple[CamState, FloatArray]:
+    def at(p: FloatArray, side: Side) -> CarriedContact:
         st = cam.state(p, side=side)
-        return st, model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force
+        force = model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force
+        return carried_contact(cam, p, force, setup=setup, profile=st.profile, motion=st.motion, side=side)
 
     return at
 
@@ -250,16 +403,14 @@ def _exact_film(
     cam: Cam, setup: DynamicsSetup, film: FilmResult, spec: LubricationSpec, modulus: float
 ) -> FilmResult:
     """The true smallest film ratio λ over the turn: the samples' refined on the exact cam."""
-    at = _pointwise(cam, setup)
-    roller = setup.roller_radius or None
+    at = _carried_at(cam, setup)
 
     def ratio(p: FloatArray, side: Side) -> FloatArray:
-        st, force = at(p, side)
-        u = contact_motion(cam, p, omega=setup.omega, profile=st.profile, motion=st.motion).entraining_speed
+        carried = at(p, side)
         h = minimum_film_thickness(
-            load_per_length=force / setup.contact_length,
-            speed=u,
-            curvature=contact_curvature(st.profile.rho, roller_radius=roller),
+            load_per_length=carried.load / setup.contact_length,
+            speed=carried.motion.entraining_speed,
+            curvature=carried.curvature,
             modulus=reduced_modulus(modulus),
             viscosity_Pa_s=spec.viscosity_Pa_s,
             pressure_viscosity_coefficient=spec.pressure_viscosity_coefficient,
@@ -273,7 +424,11 @@ def _exact_film(
     if not low.value < film.min_ratio:
         return film
     exact = replace(
-        film, min_ratio=low.value, angle=low.phi, min_thickness_um=low.value * spec.composite_roughness_um
+        film,
+        min_ratio=low.value,
+        angle=low.phi,
+        min_thickness_um=low.value * spec.composite_roughness_um,
+        flank=at(np.array([low.phi]), low.side or "right").flank_at(0),
     )
     return replace(exact, findings=film_findings(exact))
 
@@ -282,13 +437,11 @@ def _exact_track(
     cam: Cam, setup: DynamicsSetup, phi: FloatArray, track: TrackLife, spec: LifeSpec
 ) -> TrackLife:
     """The track's true largest load-stress factor (and so its life), refined on the exact cam."""
-    at = _pointwise(cam, setup)
-    roller = setup.roller_radius or None
+    at = _carried_at(cam, setup)
 
     def factor(p: FloatArray, side: Side) -> FloatArray:
-        st, force = at(p, side)
-        curvature = contact_curvature(st.profile.rho, roller_radius=roller)
-        return load_stress_factor(force, curvature=curvature, length=setup.contact_length)
+        carried = at(p, side)
+        return load_stress_factor(carried.load, curvature=carried.curvature, length=setup.contact_length)
 
     high = maximum(factor, phi, _joints(cam), values=track.factor)
     if spec.track is None or not high.value > track.factor_max:
@@ -302,6 +455,7 @@ def _exact_track(
         cycles=cycles,
         hours=hours,
         days=None if spec.hours_per_day is None else hours / spec.hours_per_day,
+        flank=at(np.array([high.phi]), high.side or "right").flank_at(0),
     )
 
 

@@ -221,6 +221,8 @@ class FilmResult:
         The smallest λ and the cam angle [rad] where it occurs.
     min_thickness_um
         h_min there [µm].
+    flank
+        A groove's flank that carries the contact there (``"inner"``/``"outer"``), else None.
     limit
         ``min_film_ratio``.
     findings
@@ -236,15 +238,19 @@ class FilmResult:
     min_thickness_um: float
     limit: float
     findings: tuple[Finding, ...] = ()
+    flank: str | None = None
 
     def summary(self) -> dict[str, Any]:
-        """The ``lubrication`` section of ``summary.json``."""
-        return {
+        """The ``lubrication`` section of ``summary.json`` (``min_film_ratio_flank`` on a groove)."""
+        out: dict[str, Any] = {
             "min_film_ratio": self.min_ratio if math.isfinite(self.min_ratio) else None,
             "min_film_ratio_angle_deg": round(math.degrees(self.angle) % 360.0, 6),
-            "min_film_thickness_um": self.min_thickness_um if math.isfinite(self.min_thickness_um) else None,
-            "film_ratio_limit": self.limit,
         }
+        if self.flank is not None:
+            out["min_film_ratio_flank"] = self.flank
+        out["min_film_thickness_um"] = self.min_thickness_um if math.isfinite(self.min_thickness_um) else None
+        out["film_ratio_limit"] = self.limit
+        return out
 
 
 def analyse_film(
@@ -315,6 +321,7 @@ def film_findings(result: FilmResult) -> tuple[Finding, ...]:
     """A soft finding when λ falls below ``min_film_ratio`` somewhere."""
     if not result.min_ratio < result.limit:
         return ()
+    flank = "" if result.flank is None else f" ({result.flank} flank)"
     return (
         Finding(
             kind="film ratio",
@@ -322,7 +329,7 @@ def film_findings(result: FilmResult) -> tuple[Finding, ...]:
             field="lubrication.min_film_ratio",
             message=(
                 f"lubricant film ratio λ falls to {result.min_ratio:.3g} at "
-                f"{math.degrees(result.angle):.1f}° (h_min {result.min_thickness_um:.3g} µm), below "
+                f"{math.degrees(result.angle):.1f}°{flank} (h_min {result.min_thickness_um:.3g} µm), below "
                 f"{result.limit:g}: the surfaces touch through the film; use a more viscous oil, smoother "
                 "surfaces, or a larger radius of curvature there"
             ),

@@ -355,6 +355,8 @@ class TrackLife:
         The same at the cam speed [h].
     days
         ``hours / hours_per_day`` or ``None``.
+    flank
+        A groove's flank whose point fails first (``"inner"``/``"outer"``), else None.
     """
 
     factor: FloatArray
@@ -364,6 +366,7 @@ class TrackLife:
     cycles: float
     hours: float
     days: float | None = None
+    flank: str | None = None
 
 
 def track_life(
@@ -508,6 +511,7 @@ def summary_entry(
         out |= {
             "track_load_stress_factor_max_MPa": track.factor_max,
             "track_load_stress_factor_angle_deg": round(math.degrees(track.angle) % 360.0, 6),
+            **({} if track.flank is None else {"track_load_stress_factor_flank": track.flank}),
             "track_cycles_per_cam_turn": track.cycles_per_cam_turn,
             "track_life_cycles": num(track.cycles),
             "track_life_h": num(track.hours),

@@ -17,7 +17,7 @@ import numpy as np
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.angles import TWO_PI
 from camcad.dynamics.arm import ArmLoad, arm_speed
-from camcad.dynamics.contact import contact_curvature, effective_modulus, hertz_stress
+from camcad.dynamics.contact import driving_curvature, effective_modulus, hertz_stress
 from camcad.dynamics.energy import FollowerLoad, contact_force, input_torque
 from camcad.dynamics.flight import impact_speed
 from camcad.dynamics.jump import covering_arc, loss_runs, preload_need, speed_bounds, speed_window
@@ -190,15 +190,9 @@ def _model(setup: DynamicsSetup) -> _Model:
             force = contact_force(axial, alpha)
             torque = input_torque(axial, setup.drive_sign * motion.v, friction_torque=dyn.friction_torque)
             ratio = np.cos(alpha)
-        if flanks is None:
-            curvature = contact_curvature(rho, roller_radius=roller)
-        else:  # a groove: the flank that drives, the inner one where F > 0, the outer one where F < 0
-            inner = contact_curvature(rho + flanks[0], roller_radius=roller)  # roller outside it
-            # the roller inside the outer flank: its radius seen from the roller is −ρ_outer, so
-            # 1/R* = 1/r_f − 1/ρ_outer (Johnson 1985, §4.3, a concave surface's radius negative)
-            outer = contact_curvature(-(rho + flanks[1]), roller_radius=roller)
-            curvature = np.where(np.asarray(force) >= 0.0, inner, outer)
-            force = np.asarray(force, dtype=float)
+        # a groove: the flank that drives, the inner one where F ≥ 0, the outer one where F < 0
+        curvature = driving_curvature(rho, force, roller_radius=roller, flank_offsets=flanks)
+        force = np.asarray(force, dtype=float)
         pressing = force if flanks is None else np.abs(force)
         stress = hertz_stress(pressing, curvature=curvature, length=length, modulus=modulus)
         return _Pointwise(

@@ -29,7 +29,9 @@ Every part is held to a limit (issue 31): a conjugate pair's figures are the
 worse of its two plates' (the second plate with its own roller, the
 ``second_plate`` section of ``summary.json``), a groove's the worse of its
 two flanks' where each drives (``dynamics.flanks``: the outer flank's load is
-the negative contact force's size). ``contact_force_min`` stays the signed
+the negative contact force's size). ``roller_life_h`` and ``min_film_ratio``
+are the smallest over the parts (a pair's second roller and plate; a groove's
+figures already cover both flanks). ``contact_force_min`` stays the signed
 figure of the first plate (positive where the first roller or the inner
 flank drives): a positive drive has no jump to keep.
 
@@ -101,6 +103,11 @@ def _sections(summary: Mapping[str, Any], name: str) -> list[Mapping[str, Any]]:
     return out
 
 
+def _parts_of(summary: Mapping[str, Any], name: str) -> list[Mapping[str, Any]]:
+    """The ``life`` or ``lubrication`` section of every part that has it (a pair's second plate's too)."""
+    return [x[name] for x in (summary, summary.get("second_plate") or {}) if name in x]
+
+
 def _worst(values: Sequence[Any], pick: Callable[[Sequence[float]], float]) -> float | None:
     known = [float(v) for v in values if v is not None]
     return pick(known) if known else None
@@ -137,8 +144,10 @@ _FIGURES: dict[str, Callable[[Analysis, Mapping[str, Any]], float | None]] = {
         [g["curvature_radius_min_mm"] for g in _sections(s, "geometry")], min
     ),
     # issue 35: life, film and drive, when the design has their tables
-    "roller_life_h": lambda a, s: s.get("life", {}).get("roller_life_h"),
-    "min_film_ratio": lambda a, s: s.get("lubrication", {}).get("min_film_ratio"),
+    "roller_life_h": lambda a, s: _worst([x.get("roller_life_h") for x in _parts_of(s, "life")], min),
+    "min_film_ratio": lambda a, s: _worst(
+        [x.get("min_film_ratio") for x in _parts_of(s, "lubrication")], min
+    ),
     "motor_rms_torque": lambda a, s: s.get("drive", {}).get("motor_rms_torque_Nm"),
     # issue 34: the elastic follower train at the design speed, when the design has [vibration]
     "vibration_residual_mm": lambda a, s: _residual(s),

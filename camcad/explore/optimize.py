@@ -348,7 +348,6 @@ class _Evaluator:
         return self.cache[physical]
 
     def _evaluate(self, physical: tuple[float, ...]) -> _Point:
-        from camcad.geometry.groove import GrooveAnalysis
         from camcad.geometry.sizing import feasible_margins
         from camcad.pipeline import analyse
 
@@ -376,10 +375,8 @@ class _Evaluator:
             min_curvature_radius=design.min_curvature_radius,
             conjugate=analysis.parts[-1].part.cam.conjugate,  # a pair's second plate's; else None
         )
-        for check in (c for r in analysis.parts for c in r.part.checks):
-            if isinstance(check, GrooveAnalysis):  # the flanks loop where their radius reaches 0 (hard)
-                flanks = (check.inner_convex_min, check.outer_concave_min)
-                rho_margin = min([rho_margin, *(f.value for f in flanks if f is not None)])
+        # every part's further curves (a groove's flanks) loop where their radius reaches 0 (hard)
+        rho_margin = min([rho_margin, *(c.radius_margin for r in analysis.parts for c in r.part.checks)])
         findings = tuple(f.message for f in analysis.findings)
         return _Point(measures, pieces, float(rho_margin), max(design.cam.base_radius, 1.0), findings, True)
 

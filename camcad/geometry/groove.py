@@ -88,6 +88,12 @@ class GrooveAnalysis:
     tool_radius_at: Extreme
     findings: tuple[Finding, ...]
 
+    @property
+    def radius_margin(self) -> float:
+        """The flanks' smallest radius [mm] that must stay positive (≤ 0: a flank loops, a hard limit)."""
+        flanks = (self.inner_convex_min, self.outer_concave_min)
+        return min(f.value for f in flanks if f is not None)
+
     def summary(self) -> dict[str, object]:
         """JSON-ready figures."""
         out: dict[str, object] = {

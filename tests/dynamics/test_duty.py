@@ -69,7 +69,7 @@ def test_sample_has_every_section_and_csv_column(tmp_path):
 
 def test_motor_torque_is_the_exact_input_torque_through_a_unit_gearbox():
     analysis = _analyse(_data(drive=DRIVE))
-    assert_allclose(analysis.duty.drive.motor_torque, analysis.dynamics.torque / 1000.0, rtol=1e-15)
+    assert_allclose(analysis.drive.drive.motor_torque, analysis.dynamics.torque / 1000.0, rtol=1e-15)
     assert analysis.summary()["drive"]["motor_max_speed_rpm"] == pytest.approx(150.0)
 
 
@@ -104,7 +104,7 @@ def test_flat_face_has_no_rolling_life_but_a_sliding_speed():
 def test_servo_follower_on_a_screw():
     drive = {"mode": "servo-follower", "screw_lead_mm": 10.0, "gear_ratio": 1.0, "gear_efficiency": 1.0}
     analysis = _analyse(_data(drive=drive))
-    d = analysis.duty.drive
+    d = analysis.drive.drive
     m = analysis.motion
     # ideal screw: T = F·p/(2π), F = m a ω² + k s + F0 + m g
     omega = 150.0 * 2 * math.pi / 60.0
@@ -211,10 +211,12 @@ def test_extremes_are_true_on_a_coarse_grid():
         {"kind": "rise", "angle": 170.0, "lift": 25.0, "law": "modified-sine"},
         {"kind": "return", "angle": 190.0, "lift": 25.0, "law": "cycloidal"},
     ]
-    coarse = _analyse({**data, "cam": {**data["cam"], "sample_step_deg": 3.0}}).duty
-    fine = _analyse({**data, "cam": {**data["cam"], "sample_step_deg": 0.01}}).duty
+    coarse_analysis = _analyse({**data, "cam": {**data["cam"], "sample_step_deg": 3.0}})
+    fine_analysis = _analyse({**data, "cam": {**data["cam"], "sample_step_deg": 0.01}})
+    coarse, fine = coarse_analysis.duty, fine_analysis.duty
     assert coarse.film.min_ratio == pytest.approx(fine.film.min_ratio, rel=1e-7)
     assert coarse.film.min_ratio <= np.min(coarse.film.ratio)
     assert coarse.track.factor_max == pytest.approx(fine.track.factor_max, rel=1e-7)
-    assert coarse.drive.peak_torque == pytest.approx(fine.drive.peak_torque, rel=1e-7)
-    assert coarse.drive.peak_torque >= np.max(np.abs(coarse.drive.motor_torque))
+    rough, smooth = coarse_analysis.drive, fine_analysis.drive
+    assert rough.drive.peak_torque == pytest.approx(smooth.drive.peak_torque, rel=1e-7)
+    assert rough.drive.peak_torque >= np.max(np.abs(rough.drive.motor_torque))

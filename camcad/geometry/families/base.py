@@ -68,11 +68,16 @@ class Drive(TypedDict):
 
 
 class PartCheck(Protocol):
-    """A family's own check of a part (a groove's flanks): its findings and its summary figures."""
+    """A family's own check of a part (a groove's flanks): findings, radius margin, summary figures."""
 
     @property
     def findings(self) -> tuple[Finding, ...]:
         """The check's broken limits."""
+        ...
+
+    @property
+    def radius_margin(self) -> float:
+        """The smallest radius [mm] of the part's further curves that must stay positive (a flank's)."""
         ...
 
     def summary(self) -> dict[str, Any]:
@@ -206,6 +211,16 @@ class PartResults(Protocol):
         """A :class:`~camcad.fit.ProfileFit` per flank (``part.flanks``), or none."""
         ...
 
+    @property
+    def fea(self) -> Any:
+        """Its plate's :class:`~camcad.fea.results.FeaResult` (``summary()``), or None."""
+        ...
+
+    @property
+    def duty(self) -> Any:
+        """Its :class:`~camcad.dynamics.duty.DutyResult` (life and film: ``summary()``), or None."""
+        ...
+
 
 class CamFamily(Protocol):
     """A cam family: the parts it makes of a cam, its own ``summary.json`` section and caption."""
@@ -227,7 +242,12 @@ class CamFamily(Protocol):
 
     @property
     def one_plate(self) -> bool:
-        """Whether the family makes one plate cut along its outline (the FE check, the rotary machine)."""
+        """Whether the family makes one plate cut along its outline (the rotary machine)."""
+        ...
+
+    @property
+    def plates(self) -> bool:
+        """Whether each part made is a plate cut along its outline (the FE check holds each by its bore)."""
         ...
 
     def check(

@@ -28,6 +28,7 @@ class ConjugateFamily:
     table = "conjugate"
     needs_roller = True
     one_plate = False
+    plates = True
 
     def check(
         self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
@@ -57,7 +58,7 @@ class ConjugateFamily:
             raise DesignError(*problem)
 
     def summary(self, results: Sequence[PartResults]) -> dict[str, Any]:
-        """The ``second_plate`` section: its geometry, its dynamics and its fit."""
+        """The ``second_plate`` section: its geometry, dynamics, fit, FE check, life and film."""
         second = results[1]
         plate: dict[str, Any] = {
             "single_plate": not second.part.made,
@@ -66,6 +67,10 @@ class ConjugateFamily:
         }
         if second.fit is not None:
             plate["fit"] = second.fit.summary()
+        if second.fea is not None:
+            plate["fea"] = second.fea.summary()  # the FE check of the second plate, its own roller's load
+        if second.duty is not None:
+            plate |= second.duty.summary()  # its roller's and track's life, its film (its own roller)
         return {"second_plate": plate}
 
     def caption(self, parts: Sequence[Part]) -> str:

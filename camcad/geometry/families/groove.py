@@ -28,6 +28,7 @@ class GrooveFamily:
     table = "groove"
     needs_roller = True
     one_plate = False
+    plates = False  # a blank with a pocket
 
     def check(
         self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float

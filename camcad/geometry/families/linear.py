@@ -43,7 +43,8 @@ class LinearFamily:
     name = "linear"
     table = "linear"
     needs_roller = False  # a curved (mushroom) face works too; a flat face is refused in check_cam
-    one_plate = False  # no rotary machine, no FE check of a disc
+    one_plate = False  # no rotary machine
+    plates = False  # a bar, not a disc: no FE check of a plate
 
     def check(
         self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float

@@ -19,6 +19,7 @@ class PlateFamily:
     table = None
     needs_roller = False
     one_plate = True
+    plates = True
 
     def check(
         self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
