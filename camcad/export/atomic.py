@@ -25,6 +25,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from camcad.errors import ExportError, OutputError
 
@@ -224,20 +225,36 @@ def _remove_folders(created: list[Path]) -> None:
 
 @contextmanager
 def _signals_held() -> Iterator[None]:
-    """Hold SIGINT, SIGTERM and SIGHUP back until the block ends (main thread, POSIX only).
+    """Hold SIGINT, SIGTERM and SIGHUP back until the block ends (main thread only).
 
     Moving the files and cleaning up take milliseconds; a signal in between
     would leave a half-moved output folder, so it is delivered afterwards.
+    The signals' Python handlers are swapped for one that only notes them, and
+    the first noted one is raised again when the block ends. A thread signal
+    mask would not do: the kernel hands a process signal to any thread that
+    does not block it (numpy's BLAS threads, started before the mask), whose
+    C handler then has the main thread's Python handler run inside the block.
     """
-    held = {signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", signal.SIGTERM)}
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
-        yield  # pragma: no cover - Windows or a worker thread
+    if threading.current_thread() is not threading.main_thread():
+        yield  # pragma: no cover - a worker thread cannot set handlers
         return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    pending: list[int] = []
+
+    def note(signum: int, frame: object) -> None:
+        pending.append(signum)
+
+    previous: dict[int, Any] = {}
+    for sig in (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", signal.SIGTERM)):
+        handler = signal.getsignal(sig)
+        if handler is not None:  # None: set outside Python, cannot be put back
+            previous[sig] = signal.signal(sig, note)
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if pending:
+            signal.raise_signal(pending[0])  # its own handler runs now, after the block
 
 
 @contextmanager

@@ -211,7 +211,7 @@ def test_a_grooves_roller_rolls_on_the_flank_that_drives(groove):
 
 
 def test_a_pairs_check_rows_name_the_second_plates_life_and_film(pair):
-    from camcad.cli import _duty_rows
+    from camcad.cli.render import _duty_rows
 
     rows = dict(_duty_rows(pair.summary()["second_plate"], "second plate "))
     assert rows["second plate roller L10 life"].startswith(f"{pair.parts[1].duty.roller.hours:.4g} h")
