@@ -136,7 +136,7 @@ class Analysis:
 
     @property
     def findings(self) -> tuple[Finding, ...]:
-        """Every broken limit of every stage and part, hard ones first (see :mod:`camcad.findings`)."""
+        """Every finding of every stage and part: hard, soft, then notes (:mod:`camcad.findings`)."""
         first, *later = self.parts
         found = (
             *first.geometry.findings,
@@ -148,20 +148,12 @@ class Analysis:
             *(self.duty.findings if self.duty is not None else ()),
             *(self.vibration.findings if self.vibration is not None else ()),
         )
-        return tuple(sorted(found, key=lambda f: not f.hard))
-
-    @property
-    def warnings(self) -> list[str]:
-        """Every non-fatal message of every stage: soft findings and notes."""
-        fea = list(self.fea.warnings) if self.fea is not None else []
-        duty = [f.message for f in self.duty.findings] if self.duty is not None else []
-        vib = [f.message for f in self.vibration.findings if not f.hard] if self.vibration is not None else []
-        return [*self.geometry.warnings, *self.dynamics.warnings, *fea, *duty, *vib]
+        return tuple(sorted(found, key=lambda f: f.rank))
 
     @property
     def violations(self) -> list[str]:
-        """The kinds of the broken limits, hard and soft (``camcad check`` exits 3 when any)."""
-        return list(dict.fromkeys(f.kind for f in self.findings))
+        """The kinds of the broken limits, hard and soft, not notes (``camcad check`` exits 3 when any)."""
+        return list(dict.fromkeys(f.kind for f in self.findings if not f.note))
 
     def summary(self) -> dict[str, Any]:
         """The content of ``summary.json``; a new dict on each call, the caller's to change.
@@ -190,7 +182,6 @@ class Analysis:
             out |= self.duty.summary()  # life, lubrication, drive
         if self.vibration is not None:
             out["vibration"] = self.vibration.summary()
-        out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]
         return out

@@ -421,7 +421,7 @@ def build(
         analysis = analyse(
             design, fit=True, toolpath="gcode" in groups, progress=progress, fea="fea" in groups
         )
-        soft = [f for f in analysis.findings if not f.hard]
+        soft = [f for f in analysis.findings if f.severity is Severity.SOFT]
         if strict and soft:
             listed = "; ".join(f"{f.field}: {f.message}" for f in soft)
             raise DesignLimitError(f"--strict: {len(soft)} soft limit(s) broken: {listed}")

@@ -27,7 +27,7 @@ import numpy as np
 from camcad._plots import Plot, compare_plots, report_plots
 from camcad._plots.compare import compare_colors
 from camcad.export.records import write_text
-from camcad.findings import Finding
+from camcad.findings import Finding, Severity
 from camcad.report_tables import (
     fmt,
     joint_rows,
@@ -263,9 +263,8 @@ def _jump_lines(analysis: Analysis, summary: Mapping[str, Any]) -> list[str]:
 def _alerts(analysis: Analysis, summary: Mapping[str, Any]) -> str:
     """The banner: hard limits, soft limits, then notes and large acceleration jumps (camcad.findings)."""
     hard = [f for f in analysis.findings if f.hard]
-    soft = [f for f in analysis.findings if not f.hard]
-    said = {f.message for f in analysis.findings}
-    notes = [w for w in analysis.warnings if w not in said] + _jump_lines(analysis, summary)
+    soft = [f for f in analysis.findings if f.severity is Severity.SOFT]
+    notes = [f.message for f in analysis.findings if f.note] + _jump_lines(analysis, summary)
     out = []
     if hard:
         out.append(_alert("bad", "Hard limits broken", _finding_lines(hard), anchor="violations"))
@@ -464,7 +463,7 @@ def _quantities_table(section: Mapping[str, Any], *, skip: Sequence[str] = ()) -
         if key in skip:
             continue
         if isinstance(value, Mapping):
-            out.append(f"<h4>{_e(label(key))}</h4>{_quantities_table(value, skip=('warnings',))}")
+            out.append(f"<h4>{_e(label(key))}</h4>{_quantities_table(value)}")
         elif _is_records(value):
             out.append(f"<h4>{_e(label(key))}</h4>{_records_table(value)}")
     return "".join(out) or f"<p>{_DASH}</p>"
@@ -480,7 +479,7 @@ def _records_table(records: Sequence[Mapping[str, Any]]) -> str:
 
 
 _SECTION_TITLES = {"gcode": "G-code", "fit": "NURBS fit", "second_plate": "Second plate"}
-_NOT_TABLES = ("camcad_version", "design", "warnings", "violations", "findings")
+_NOT_TABLES = ("camcad_version", "design", "violations", "findings")
 
 
 def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
@@ -491,7 +490,7 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
         if name in _NOT_TABLES or not isinstance(section, Mapping):
             continue
         title = _SECTION_TITLES.get(name, name.replace("_", " ").capitalize())
-        body = _quantities_table(section, skip=("warnings", "joints"))
+        body = _quantities_table(section, skip=("joints",))
         wide = ' class="wide"' if 'class="scroll records"' in body else ""  # a records table: full width
         out.append(f'<div id="table-{_e(name)}"{wide}><h3>{_e(title)}</h3>{body}</div>')
     motion = summary.get("motion", {})
@@ -769,8 +768,8 @@ def render_compare(analyses: Sequence[Analysis]) -> str:
     rows = [[_e(c) for c in row] for row in table[1:]]
     alerts = []
     for name, analysis in zip(names, analyses, strict=True):
-        said = {f.message for f in analysis.findings}
-        findings = [*_finding_lines(analysis.findings), *(w for w in analysis.warnings if w not in said)]
+        limits = [f for f in analysis.findings if not f.note]
+        findings = [*_finding_lines(limits), *(f.message for f in analysis.findings if f.note)]
         findings += _jump_lines(analysis, analysis.summary())
         if findings:
             alerts.append(_alert("bad" if analysis.violations else "warn", name, findings))

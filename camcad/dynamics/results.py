@@ -84,11 +84,9 @@ class DynamicsResult:
         (high may be ``inf``); ``None`` if no speed does.
     allowable_stress
         ``[dynamics].allowable_stress`` [MPa] or ``None``.
-    warnings
-        Every message for the report, one sentence each: the findings' and
-        notes on the model's validity (guide forces changing side).
     findings
-        The broken limits (jump, contact stress) as typed findings.
+        The broken limits (jump, contact stress) and the notes on the
+        model's validity (guide forces changing side) as typed findings.
     contact_force_min, contact_force_max, torque_min, torque_max, hertz_stress_max
         True extremes over the turn (one-sided limits at joints included), when
         the analysis had the exact cam; else ``None`` and the summary falls back
@@ -110,7 +108,6 @@ class DynamicsResult:
     preload_deflection: float | None = None
     speed_range_rpm: tuple[float, float] | None = None
     allowable_stress: float | None = None
-    warnings: tuple[str, ...] = ()
     findings: tuple[Finding, ...] = ()
     contact_force_min: Extreme | None = None
     contact_force_max: Extreme | None = None
@@ -149,8 +146,8 @@ class DynamicsResult:
             ``None``); then ``jump`` (bool), ``jump_range_deg`` ([start, end]
             in degrees, start > end through 0°, or ``None``),
             ``min_preload_N``, ``speed_range_rpm`` ([low, high] or ``None``;
-            both left out for positive drive, where no jump check applies)
-            and ``warnings`` (list of str). A groove adds
+            both left out for positive drive, where no jump check applies).
+            A groove adds
             ``hertz_stress_max_flank`` (``"inner"`` or ``"outer"``, the flank
             that carries the peak) and ``flanks``: for each flank the largest
             load it carries where it drives (``contact_force_max_N``) and its
@@ -179,7 +176,6 @@ class DynamicsResult:
                 ("min_preload_N" if self.preload_unit == "N" else "min_preload_N_mm"): self.min_preload,
                 "speed_range_rpm": None if self.speed_range_rpm is None else list(self.speed_range_rpm),
             }
-        out["warnings"] = list(self.warnings)
         if self.flank_force_max is not None and self.flank_stress_max is not None:
             out["hertz_stress_max_flank"] = self.hertz_stress_flank
             out["flanks"] = {

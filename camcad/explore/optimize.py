@@ -380,7 +380,7 @@ class _Evaluator:
             if isinstance(check, GrooveAnalysis):  # the flanks loop where their radius reaches 0 (hard)
                 flanks = (check.inner_convex_min, check.outer_concave_min)
                 rho_margin = min([rho_margin, *(f.value for f in flanks if f is not None)])
-        findings = tuple(f.message for f in analysis.findings)
+        findings = tuple(f.message for f in analysis.findings if not f.note)
         return _Point(measures, pieces, float(rho_margin), max(design.cam.base_radius, 1.0), findings, True)
 
 

@@ -74,11 +74,6 @@ class GeometryAnalysis:
     concave_radius_min: Extreme | None
 
     @property
-    def warnings(self) -> tuple[str, ...]:
-        """The messages of the soft findings (pressure angle)."""
-        return tuple(f.message for f in self.findings if not f.hard)
-
-    @property
     def profile_radius(self) -> FloatArray:
         """(n,) polar radius of the contact point [mm]."""
         return np.hypot(self.profile.point[:, 0], self.profile.point[:, 1])
@@ -96,7 +91,6 @@ class GeometryAnalysis:
         _put(out, "curvature_radius_min", self.curvature_radius_min, unit="mm")
         _put(out, "concave_radius_min", self.concave_radius_min, unit="mm")
         out["undercut"] = self.undercut is not None
-        out["warnings"] = list(self.warnings)
         if self.face_width_min is not None:
             out["face_width_min_mm"] = self.face_width_min
         return out

@@ -114,3 +114,35 @@ def test_a_velocity_jump_has_no_finite_acceleration_peak():
     ends |= {round(math.degrees(starts[i] + design.motion[i].span) % 360.0, 6) for i in moving}
     assert set(motion["velocity_jumps_deg"]) == ends
     assert motion["a_max_abs_mm_per_rad2"] is None and motion["j_max_abs_mm_per_rad3"] is None
+
+
+# Hren's tappet with the guides close to the cam (a_m = 20, b_m = 250 mm): the far guide's force N3
+# turns negative over part of the rise, where eq. 25's friction direction no longer holds
+GUIDE_FLIP = edit(edit(HREN, r"^a_m = .*$", "a_m = 20.0"), r"^b_m = .*$", "b_m = 250.0")
+
+
+def test_a_note_is_a_finding_that_changes_no_exit_code(tmp_path, capsys):
+    """What used to be a free warning string (the guide force changing side) is a NOTE finding."""
+    import json
+
+    import tomllib
+
+    from camcad.pipeline import analyse
+
+    out = tmp_path / "out"
+    assert run(tmp_path, GUIDE_FLIP, "build", "-o", str(out), "--only", "tables", "--strict") == 0
+    assert "note: guide force N3 changes side" in capsys.readouterr().err
+    found = json.loads((out / "summary.json").read_text())["findings"]
+    assert "warnings" not in json.loads((out / "summary.json").read_text())
+    (note,) = found
+    assert note["severity"] == "note" and note["field"] == "dynamics.model"
+    assert note["message"].startswith("guide force N3 changes side between")
+    # the note starts where the sampled far guide force is negative (the dynamics' own arrays)
+    dyn = analyse(parse_design(tomllib.loads(GUIDE_FLIP)), fit=False, toolpath=False).dynamics
+    i = int(np.argmin(np.abs(dyn.phi - math.radians(note["angle_deg"]))))
+    assert dyn.guide_force_far[i] < 0.0 <= dyn.guide_force_near[i]
+    assert run(tmp_path, GUIDE_FLIP, "check") == 0
+    printed = capsys.readouterr().out
+    assert "  note: guide force N3 changes side" in printed and "all design limits hold" in printed
+    assert run(tmp_path, HREN, "check") == 0  # the paper's guides: N3 stays on its side, no note
+    assert "note:" not in capsys.readouterr().out

@@ -25,7 +25,7 @@ SUMMARY_KEYS = {
         ("hertz_stress_max", "MPa"),
     )
     for suffix in (unit, "angle_deg", "side")
-} | {"jump", "jump_range_deg", "min_preload_N", "speed_range_rpm", "warnings"}
+} | {"jump", "jump_range_deg", "min_preload_N", "speed_range_rpm"}
 
 
 def analyse(design, step=None) -> DynamicsResult:
@@ -68,10 +68,10 @@ def test_allowable_stress_warns():
     design = paper_design("harmonic")
     peak = analyse(design).summary()["hertz_stress_max_MPa"]
     strict = replace(design, dynamics=replace(design.dynamics, allowable_stress=0.5 * peak))
-    warnings = analyse(strict).summary()["warnings"]
-    assert len(warnings) == 1 and "above the allowable" in warnings[0]
+    (found,) = analyse(strict).findings
+    assert found.kind == "contact stress" and "above the allowable" in found.message
     lax = replace(design, dynamics=replace(design.dynamics, allowable_stress=2.0 * peak))
-    assert analyse(lax).summary()["warnings"] == []
+    assert analyse(lax).findings == ()
 
 
 def test_contact_width_overrides_the_cam_thickness():
