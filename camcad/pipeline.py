@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import pickle
-import re
 import signal
 import sys
 import time
@@ -150,7 +149,7 @@ def analyse(
         vibration = _timed(timings, progress, "vibration", lambda: _vibration(design, cam))
         stop = [f for f in vibration.findings if f.hard]  # the follower leaves a spring-loaded cam
         if stop and strict:
-            raise DesignLimitError(f"{stop[0].field}: {stop[0].message}")
+            raise DesignLimitError(stop[0].message, field=stop[0].field)
         if vibration.compensated is not None:
             from camcad.dynamics.vibration import compensated_program
 
@@ -178,18 +177,22 @@ def analyse(
     if hard and strict:
         if geometries[0].undercut is not None:
             raise undercut_error(geometries[0], min_curvature_radius=design.min_curvature_radius)
-        raise DesignLimitError(hard[0].message)
+        raise DesignLimitError(hard[0].message, field=hard[0].field)
     setup = design.dynamics_setup()
 
     def dynamics_of(part: Part, geometry: GeometryAnalysis) -> DynamicsResult:
-        return analyse_dynamics(
-            part.cam.motion(geometry.phi),
-            pressure_angle=geometry.pressure_angle,
-            profile_rho=geometry.profile.rho,
-            # each part's own roller sets its Hertz contact (Johnson 1985, §4.3), its drive sign its force
-            setup=replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius),
-            cam=part.cam,
-        )
+        try:
+            return analyse_dynamics(
+                part.cam.motion(geometry.phi),
+                pressure_angle=geometry.pressure_angle,
+                profile_rho=geometry.profile.rho,
+                # each part's own roller sets its Hertz contact (Johnson 1985, §4.3), its drive sign its force
+                setup=replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius),
+                cam=part.cam,
+            )
+        except DesignLimitError as err:  # the guided tappet self-locks (Hren et al. eq. 25)
+            err.with_field("dynamics.b_m")  # spread its guides
+            raise
 
     dynamics = _timed(
         timings,
@@ -337,7 +340,7 @@ _STAGE_LIMITS: dict[str, tuple[type[DesignLimitError], str, str]] = {
     "fit": (FitError, "fit tolerance", "fit.tolerance"),
     "toolpath": (GougeError, "gouge", "gcode.tool_diameter"),
 }
-"""The hard limit each later stage can break: its error, the finding's kind, the default field."""
+"""The hard limit each later stage can break: its error, the finding's kind, the field when it names none."""
 
 
 def _limited(
@@ -354,18 +357,11 @@ def _limited(
     try:
         return _timed(timings, progress, stage, run)
     except error as err:
+        err.with_field(field)  # the stage's own field when it named none
         if strict:
             raise
-        found.append(_hard_finding(kind, field, err))
+        found.append(Finding(kind=kind, severity=Severity.HARD, field=err.field, message=str(err)))
         return None
-
-
-def _hard_finding(kind: str, field: str, err: Exception) -> Finding:
-    """A hard finding for a limit error a later stage raised; its message starts with the field it names."""
-    named = str(err).split(":", 1)[0]
-    if re.fullmatch(r"[a-z_]+\.[a-z_]+", named):
-        field = named
-    return Finding(kind=kind, severity=Severity.HARD, field=field, message=str(err))
 
 
 def _groups(only: Iterable[str] | None) -> set[str]:

@@ -290,7 +290,7 @@ def _check_value(
         # a check across fields (an offset beyond r_b + r_f at the file's r_b) may pass at other grid
         # values of the other variables, so it is the design's, found row by row
         own = err.message.startswith((repr(value), "unknown key", "expected", "applies to"))
-        if err.path in places and (own or variable.path.endswith(".law")):
+        if err.field in places and (own or variable.path.endswith(".law")):
             raise UsageError(flag, f"{text!r}: {err}") from None
 
 

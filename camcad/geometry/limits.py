@@ -636,4 +636,5 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
         phi_range=uc.ranges[0],
         worst=uc.worst,
         suggested_base_radius=suggestion,
+        field="cam.base_radius",
     )

@@ -27,7 +27,7 @@ from camcad._plots.design import (
     follower_drawings,
 )
 from camcad.design import parse_design
-from camcad.errors import CamcadError, DesignError
+from camcad.errors import CamcadError
 from camcad.pipeline import analyse
 from camcad.report import alerts_html, key_numbers_html
 
@@ -201,10 +201,8 @@ def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
     try:
         design = parse_design(data, source=source)
         analysis = analyse(design, fit=False, toolpath=False, strict=False)
-    except DesignError as err:
-        return {"ok": False, "errors": [{"field": err.path, "message": err.message}]}
-    except CamcadError as err:  # a limit the analysis cannot get past even when not strict
-        return {"ok": False, "errors": [{"field": getattr(err, "field", ""), "message": str(err)}]}
+    except CamcadError as err:  # bad input, or a limit the analysis cannot get past even when not strict
+        return {"ok": False, "errors": [{"field": err.field, "message": err.message}]}
     summary = analysis.summary()
     phi_deg, charts = _curves(analysis)
     return {

@@ -169,6 +169,7 @@ def _check_cutter(cam: Cam, spec: GcodeSpec) -> float:
             f"is Ø{2.0 * largest:.4f} mm (set gcode.tool_diameter to at most that)",
             phi_range=err.phi_range,
             max_tool_radius=largest,
+            field="gcode.tool_diameter",
         ) from None
 
 
@@ -219,7 +220,8 @@ def _path(cam: Cam, spec: GcodeSpec) -> _Path:
             f"gcode.machine: the tool-centre path is not star-shaped about the cam axis near cam angle "
             f"{math.degrees(bad):.2f}°: a ray from the axis meets it twice, so a tool on a line through "
             "the axis would have to turn the cam back; use machine = 'xy', a smaller tool, or a larger "
-            "cam.base_radius"
+            "cam.base_radius",
+            field="gcode.machine",
         )
     # shift whole turns so that the first rotary word lies in [0°, 360°)
     sign = 1.0 if spec.rotary_direction is Rotation.CCW else -1.0
