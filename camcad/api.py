@@ -641,7 +641,7 @@ def optimize(
     points: int = 7,
     progress: Callable[[str], None] | None = None,
 ) -> OptimizeResult:
-    """Constrained optimisation over design-file keys, as ``camcad optimize`` does.
+    """Constrained optimization over design-file keys, as ``camcad optimize`` does.
 
     Parameters
     ----------

@@ -48,7 +48,7 @@ LAYER_ORDER: tuple[frozenset[str], ...] = (
     frozenset({"design"}),  # the schema sits above every stage
     frozenset({"analysis", "report", "report_tables", "_plots"}),
     frozenset({"pipeline"}),
-    frozenset({"explore"}),  # camcad/explore/ (issue 20): optimise, sweep, Pareto; analyses through pipeline
+    frozenset({"explore"}),  # camcad/explore/ (issue 20): optimize, sweep, Pareto; analyses through pipeline
     # serve/ (issue 19): the live designer; api: the Python API (issue 39)
     frozenset({"cli", "serve", "api", "__init__", "__main__"}),
 )

@@ -11,12 +11,12 @@ rpm, N, N/mm, MPa).
 A variant is the design's TOML mapping with the variables' values written in,
 validated again by :func:`camcad.design.parse_design`: every variant obeys
 the same rules as a design file, its errors name the field, and the result of
-an optimisation can be written back as a design file
+an optimization can be written back as a design file
 (:func:`camcad.design.toml_text.toml_text`).
 
 Value syntax (``--grid`` and ``--vary``): ``name=start:stop:count`` (a grid of
 ``count`` equally spaced values, both ends included), ``name=low:high`` (a
-continuous range: optimisation, Latin-hypercube sampling) or
+continuous range: optimization, Latin-hypercube sampling) or
 ``name=a,b,c`` (discrete choices, tried one by one).
 """
 
@@ -206,7 +206,7 @@ def parse_variable(
         The option, named by every error (``--grid``, ``--vary``).
     counted
         True: a range must carry a count (a grid sweep); False: a range is
-        continuous and a count is refused (optimisation, Latin-hypercube
+        continuous and a count is refused (optimization, Latin-hypercube
         sampling).
     source
         The design file's name, for the validated designs.
