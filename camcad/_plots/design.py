@@ -310,7 +310,7 @@ SECOND_PLATE = "#b5651d"
 def _draw_pocket(ax: Axes, analysis: Analysis, pocket: Pocket) -> None:
     """A part with a pocket seen from its face: the blank, the pocket (white) between its flanks."""
     cam, phi = analysis.cam, analysis.geometry.phi
-    inner, outer = (np.asarray(cam.offset(phi, flank.offset).point) for flank in pocket.flanks)
+    inner, outer = (np.asarray(cam.offset_curve(phi, flank.offset).point) for flank in pocket.flanks)
     shape(
         ax, Circle((0.0, 0.0), pocket.outer_radius, facecolor="#dbe6f1", edgecolor="#1f3b57", linewidth=1.2)
     )

@@ -155,7 +155,7 @@ LAYERS: dict[str, tuple[int, str]] = {
 class DxfCurve:
     """One certified closed curve of a drawing: its layer, its fit, and the exact curve it stands for.
 
-    The exact curve is ``cam.offset(φ, offset)``: the profile for ``offset = 0``,
+    The exact curve is ``cam.offset_curve(φ, offset)``: the profile for ``offset = 0``,
     a groove's flank for the offsets of :func:`camcad.geometry.groove.flank_offsets`.
     """
 
@@ -569,7 +569,7 @@ def profile_arcs_document(
 ) -> Drawing:
     """Build the ``profile_arcs.dxf`` document: the profile as tangent arcs, the bore as ARC/LINE/CIRCLE.
 
-    The arcs are biarcs through the exact profile ``cam.offset(φ, 0)``
+    The arcs are biarcs through the exact profile ``cam.offset_curve(φ, 0)``
     within the fit tolerance ``fit.tolerance``, measured two-way
     (:func:`~camcad.export._outline.arc_outline`); consecutive arcs share end
     points and tangents. ``options`` is accepted for a uniform signature.
@@ -580,7 +580,7 @@ def profile_arcs_document(
     for curve in _curves(fit, curves):
 
         def exact(phi: np.ndarray, d: float = curve.offset) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-            o = cam.offset(phi, d)
+            o = cam.offset_curve(phi, d)
             return o.point, o.d1, o.d2
 
         tol = curve.fit.tolerance

@@ -109,7 +109,7 @@ def _ray_angle(points: FloatArray, sign: float) -> FloatArray:
 
 def _curve(cam: Cam, phi: FloatArray, distance: float) -> FloatArray:
     """(n, 2) points of the profile (distance 0) or of its offset by ``distance`` [mm]."""
-    out: FloatArray = (cam.profile(phi) if distance == 0.0 else cam.offset(phi, distance)).point
+    out: FloatArray = (cam.profile(phi) if distance == 0.0 else cam.offset_curve(phi, distance)).point
     return out
 
 
@@ -119,7 +119,7 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation, distance: f
     Parameters
     ----------
     cam
-        The exact cam; ``cam.offset(phi, distance)`` gives the point at cam
+        The exact cam; ``cam.offset_curve(phi, distance)`` gives the point at cam
         angle φ (the contact point for ``distance = 0``, the centre of a
         wheel of radius ``distance`` rolling on the profile otherwise).
     theta

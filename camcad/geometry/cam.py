@@ -276,7 +276,7 @@ class Cam:
         base, drho = line_envelope(m.phi, element, self.sigma)
         return base, drho, 0.0
 
-    def offset(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
+    def offset_curve(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
         """The profile offset outward by ``distance`` [mm] at cam angles φ [rad].
 
         ``distance = r`` is the centre path of a milling tool (or a roller) of
@@ -288,8 +288,8 @@ class Cam:
         return offset_curve(base, drho, distance + profile_at)
 
     def profile(self, phi: ArrayLike, *, side: Side = "right") -> CurveSample:
-        """The cam profile (contact point C) at cam angles φ [rad]; ``side`` as in :meth:`offset`."""
-        return self.offset(phi, 0.0, side=side)
+        """The cam profile (contact point C) at cam angles φ [rad]; ``side`` as in :meth:`offset_curve`."""
+        return self.offset_curve(phi, 0.0, side=side)
 
     def _driven_point(self, phi: ArrayLike, side: Side) -> tuple[CurveSample, FloatArray]:
         """The profile, and the follower point that is driven (roller centre or contact), machine frame."""

@@ -82,7 +82,7 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
     pocket = analysis.parts[0].part.pocket
     groove = None
     if pocket is not None:  # as the report draws it
-        inner, outer = (_xy(cam.offset(geo.phi, flank.offset).point) for flank in pocket.flanks)
+        inner, outer = (_xy(cam.offset_curve(geo.phi, flank.offset).point) for flank in pocket.flanks)
         groove = {"outer_radius": pocket.outer_radius, "inner": inner, "outer": outer, "width": pocket.width}
     second = None
     for result in analysis.parts[1:]:  # a pair's second plate

@@ -6,7 +6,7 @@ end mill cutting with its side, or a grinding wheel), its axis parallel to
 the cam's, has its centre on the machine's +X half-line through the cam
 axis, X millimetres from it. Turning the cam by θ (counter-clockwise seen
 from +Z) shows the tool centre at R(−θ)·(X, 0) in the cam frame, so the tool
-follows the exact offset curve Q(φ) = ``cam.offset(φ, r_tool)`` when
+follows the exact offset curve Q(φ) = ``cam.offset_curve(φ, r_tool)`` when
 
     X = |Q(φ)|,    θ = −atan2(Q_y, Q_x)   (unwrapped),
 
@@ -197,7 +197,7 @@ class _Path:
 
 def _polar(cam: Cam, r: float, phi: FloatArray, side: Side = "right") -> tuple[FloatArray, FloatArray]:
     """|Q| [mm] and θ = −atan2(Q_y, Q_x) [rad, wrapped] of the tool centre at cam angles φ."""
-    q = cam.offset(phi, r, side=side).point
+    q = cam.offset_curve(phi, r, side=side).point
     return np.hypot(q[:, 0], q[:, 1]), -np.arctan2(q[:, 1], q[:, 0])
 
 
@@ -325,7 +325,7 @@ def plan_rotary(cam: Cam, spec: GcodeSpec, *, name: str, thickness: float) -> Ro
     Parameters
     ----------
     cam
-        The cam; its exact offset ``cam.offset(φ, r_tool)`` is the tool-centre path.
+        The cam; its exact offset ``cam.offset_curve(φ, r_tool)`` is the tool-centre path.
     spec
         ``[gcode]`` with ``machine = "rotary"``: tool (end mill or wheel)
         diameter, tolerance, direction, start angle, feeds, step-down.
