@@ -198,7 +198,7 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
     Where the velocity jumps (``velocity_jumps_deg``) the acceleration is an
     impulse: the peaks of |a| and |j| are infinite and reported as ``None``.
     """
-    u = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    u = cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     out: dict[str, Any] = {f"lift_{u}": cam.program.lift}
     joints = [bp.phi for bp in cam.program.breakpoints]
     # where v jumps, a is an impulse and j is undefined: their peaks are infinite, not the samples'

@@ -650,7 +650,7 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
     )
 
     cam, design = analysis.cam, analysis.design
-    unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    unit = cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     duty = analysis.duty.csv_columns() if analysis.duty is not None else None  # life, film, drive columns
     motion_csv = write_motion_csv(folder / "motion.csv", cam, unit=unit)
     profile_csv = write_profile_csv(folder / "profile.csv", analysis.geometry)
@@ -690,7 +690,7 @@ def _drive_table(analysis: Analysis, folder: Path) -> list[Path]:
     options = analysis.design.tables
     if options.cam_table_points is None:
         return []
-    unit = analysis.cam.follower.kind.lift_unit
+    unit = analysis.cam.follower_spec.kind.lift_unit
     return [
         write_drive_table(
             folder / "cam_table.csv",

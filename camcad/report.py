@@ -249,7 +249,7 @@ def _finding_lines(findings: Sequence[Finding]) -> list[str]:
 def _jump_lines(analysis: Analysis, summary: Mapping[str, Any]) -> list[str]:
     """Banner lines for large acceleration jumps at motion joints (see :mod:`camcad.report_tables`)."""
     motion = summary.get("motion", {})
-    unit = analysis.cam.follower.kind.lift_unit
+    unit = analysis.cam.follower_spec.kind.lift_unit
     a_peak = motion.get(f"a_max_abs_{unit}_per_rad2")
     return large_acceleration_jumps(
         motion.get("joints", []),
@@ -291,7 +291,7 @@ def _key_numbers(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, An
     dyn = summary.get("dynamics", {})
     fit = summary.get("fit")
     d = analysis.dynamics
-    unit = analysis.cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    unit = analysis.cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     return {
         "lift": analysis.cam.program.lift,
         "stroke": motion.get(f"stroke_{unit}"),  # the true travel, max − min of s
@@ -397,7 +397,7 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
             f"{gcode.get('blocks')} blocks",
             f"{gcode.get('arcs')} arcs, about {minutes:.1f} min; {tool}",
         )
-    lift = cam.follower.kind.lift
+    lift = cam.follower_spec.kind.lift
     shown = lift.symbol
     stroke_note = ""
     if k["stroke"] is not None and round(k["stroke"], 3) != round(k["lift"], 3):  # a segment overshoots
@@ -433,7 +433,7 @@ def _program_table(analysis: Analysis) -> str:
                 _e(law),
             ]
         )
-    lift = f"lift [{analysis.cam.follower.kind.lift.short}]"
+    lift = f"lift [{analysis.cam.follower_spec.kind.lift.short}]"
     header = ["#", "segment", "start [°]", "span [°]", lift, "law"]
     return _table(header, rows)
 
@@ -496,7 +496,7 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> str:
     motion = summary.get("motion", {})
     joints = motion.get("joints")
     if joints:
-        unit = analysis.cam.follower.kind.lift_unit
+        unit = analysis.cam.follower_spec.kind.lift_unit
         header, rows = joint_rows(
             joints,
             unit=unit,
@@ -694,7 +694,7 @@ def compare_table(analyses: Sequence[Analysis]) -> list[list[str]]:
 
 def _lift_unit_text(analyses: Sequence[Analysis]) -> str:
     """The lift's unit of several designs as shown: ``mm`` (slides), ``°`` (arms) or ``mm or °``."""
-    units = {a.cam.follower.kind.lift.short for a in analyses}
+    units = {a.cam.follower_spec.kind.lift.short for a in analyses}
     return units.pop() if len(units) == 1 else "mm or °"
 
 

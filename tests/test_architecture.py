@@ -384,7 +384,7 @@ def test_follower_kind_scan_flags_a_made_up_module():
             "7: FollowerKind",
         ]
     )
-    clean = "def f(cam):\n    return cam.has_pitch_curve and cam.follower.kind.lift.angular\n"
+    clean = "def f(cam):\n    return cam.has_pitch_curve and cam.follower_spec.kind.lift.angular\n"
     assert follower_kind_uses(ast.parse(clean), KNOWN_FOLLOWER_WORDS) == []
 
 

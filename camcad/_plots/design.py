@@ -76,7 +76,7 @@ def motion_plot(analysis: Analysis) -> Plot:
     """s, v, a, j (or ψ and its derivatives for an arm) against the cam angle."""
     m = analysis.motion
     phi = np.degrees(m.phi)
-    labels = analysis.cam.follower.kind.lift.labels  # an arm's lift is its swing ψ, in degrees
+    labels = analysis.cam.follower_spec.kind.lift.labels  # an arm's lift is its swing ψ, in degrees
     values = (m.s, m.v, m.a, m.j)
     blends = analysis.cam.program.blend_points  # joints solved to match their neighbours (issue 16)
     blend_deg = np.degrees([b.phi for b in blends])
@@ -93,7 +93,7 @@ def motion_plot(analysis: Analysis) -> Plot:
         for k, (label, v) in enumerate(zip(labels, values, strict=True))
     ]
     bounds_deg, segments = _segments(analysis)
-    what = analysis.cam.follower.kind.lift.title
+    what = analysis.cam.follower_spec.kind.lift.title
     blend_note = (
         f"; ticks along the bottom mark the {len(blends)} blend points, where the laws meet continuous "
         + ("to the jerk" if smooth >= 3 else "to the acceleration" if smooth == 2 else f"to order {smooth}")

@@ -415,7 +415,7 @@ def dxf_text(text: str) -> str:
 
 def _annotation_lines(cam: Cam, plate: Plate, curves: Sequence[DxfCurve]) -> list[str]:
     """Plain-ASCII lines of the annotation block."""
-    follower, bore = cam.follower, plate.bore
+    follower, bore = cam.follower_spec, plate.bore
     sizes = f"base radius {cam.base_radius:.3f} mm, thickness {plate.thickness:.3f} mm"
     if bore is not None:
         sizes += f", bore dia {2.0 * bore.radius:.3f} mm"

@@ -108,8 +108,9 @@ class Cam:
         The motion program s(φ).
     base_radius
         r_b [mm]: the smallest radius of the cam profile.
-    follower
-        The design's follower table (kind, roller radius r_f [mm], offset e [mm]).
+    follower_spec
+        The design's ``[follower]`` table (kind, roller radius r_f [mm],
+        offset e [mm]); the follower it builds is :attr:`kinematics`.
     rotation
         ``CCW`` (default) or ``CW``.
 
@@ -126,7 +127,7 @@ class Cam:
 
     program: MotionProgram
     base_radius: float
-    follower: FollowerSpec
+    follower_spec: FollowerSpec
     rotation: Rotation = Rotation.CCW
     sample_step: float = math.radians(0.1)
     conjugate: ConjugateSpec | None = None  # set: this is the pair's second plate, driving the tied roller
@@ -140,7 +141,7 @@ class Cam:
         return cls(
             program=MotionProgram.from_segments(design.motion),
             base_radius=design.cam.base_radius,
-            follower=design.follower,
+            follower_spec=design.follower,
             rotation=design.cam.rotation,
             sample_step=design.cam.sample_step,
         )
@@ -159,7 +160,7 @@ class Cam:
         return out
 
     def _follower(self) -> Follower:
-        first = follower_from_spec(self.follower, self.base_radius)
+        first = follower_from_spec(self.follower_spec, self.base_radius)
         if self.conjugate is None:
             return first
         top_phi = max((bp.phi for bp in self.program.breakpoints), key=lambda p: float(self.motion(p).s[0]))
@@ -201,7 +202,7 @@ class Cam:
     @property
     def eccentricity(self) -> float:
         """Follower eccentricity e [mm] (the design file's ``offset``): its axis is the line x = e."""
-        return self.follower.eccentricity
+        return self.follower_spec.eccentricity
 
     @property
     def sigma(self) -> float:

@@ -300,7 +300,7 @@ def analyse_geometry(
     if alpha_max.value > max_pressure_angle:
         findings.append(_pressure_finding(phi, alpha, alpha_max, max_pressure_angle))
     face_min = None
-    if cam.follower.kind.face:
+    if cam.follower_spec.kind.face:
         check = _face_check if cam.kinematics.guide.pivot is None else _arm_face_check
         face_min, found = check(reach_min, reach_max, face_width, face_margin)
         findings += found
@@ -459,7 +459,7 @@ def _velocity_jumps(cam: Cam) -> list[Finding]:
     rests, typically).
     """
     out = []
-    unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    unit = cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     shown = "°" if unit == "deg" else unit
     for joint in cam.program.joints():
         if joint.continuity > 0:
@@ -506,7 +506,7 @@ def _reversals(cam: Cam) -> list[Finding]:
     """
     out = []
     program = cam.program
-    unit = cam.follower.kind.lift_unit
+    unit = cam.follower_spec.kind.lift_unit
     shown = "°" if unit == "deg" else unit
     for k, (seg, start) in enumerate(zip(program.segments, program.starts, strict=True)):
         if seg.kind.value not in ("rise", "return") or seg.lift <= 0.0:
@@ -587,7 +587,7 @@ def _overshoot(
     way = "forwards" if seg.kind.value == "return" else "backwards"
     where = "start" if head else "end"
     first_deg, last_deg = sorted((math.degrees(edge), math.degrees(phi)))
-    unit = cam.follower.kind.lift_unit
+    unit = cam.follower_spec.kind.lift_unit
     return Finding(
         kind="motion reversal",
         severity=Severity.SOFT,

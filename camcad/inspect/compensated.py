@@ -49,7 +49,7 @@ class CompensatedCam(Cam):
         return cls(
             program=cam.program,
             base_radius=cam.base_radius,
-            follower=cam.follower,
+            follower_spec=cam.follower_spec,
             rotation=cam.rotation,
             sample_step=cam.sample_step,
             conjugate=cam.conjugate,

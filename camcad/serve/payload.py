@@ -120,7 +120,7 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
     spec = analysis.design.dynamics
     phi = np.asarray(geo.phi)
     index = np.unique(np.linspace(0, len(phi) - 1, min(CURVE_POINTS, len(phi))).round().astype(int))
-    lift = cam.follower.kind.lift
+    lift = cam.follower_spec.kind.lift
     u, x = lift.short, lift.variable
     limit = math.degrees(geo.max_pressure_angle)
     clip = CURVATURE_CLIP * cam.base_radius
@@ -213,7 +213,7 @@ def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
         "drawing": _drawing(analysis),
         "phi_deg": phi_deg,
         "charts": charts,
-        "lift_unit": analysis.cam.follower.kind.lift.short,
+        "lift_unit": analysis.cam.follower_spec.kind.lift.short,
         "summary": {k: summary[k] for k in ("motion", "geometry", "dynamics") if k in summary},
         "findings": [f.summary() for f in analysis.findings],
     }

@@ -44,12 +44,12 @@ def roller_cam(rotation: Rotation, *, d: float = 120.0, arm: float = 90.0, lift:
     spec = FollowerSpec(
         kind=FOLLOWER_TYPES["oscillating-roller"], roller_radius=15.0, pivot_distance=d, arm_length=arm
     )
-    return Cam(program=program(lift), base_radius=50.0, follower=spec, rotation=rotation)
+    return Cam(program=program(lift), base_radius=50.0, follower_spec=spec, rotation=rotation)
 
 
 def flat_cam(rotation: Rotation, *, f: float = 5.0) -> Cam:
     spec = FollowerSpec(kind=FOLLOWER_TYPES["oscillating-flat"], pivot_distance=130.0, face_offset=f)
-    return Cam(program=program(10.0), base_radius=40.0, follower=spec, rotation=rotation)
+    return Cam(program=program(10.0), base_radius=40.0, follower_spec=spec, rotation=rotation)
 
 
 PHI = np.linspace(0.0, 2.0 * math.pi, 181, endpoint=False) + 0.013
@@ -176,7 +176,7 @@ def test_a_very_long_arm_becomes_a_slide(rotation: Rotation) -> None:
         u = -np.array([-(start - k.pivot)[1], (start - k.pivot)[0]]) / arm  # driven direction at ψ = 0
         e = -float(start @ np.array([-u[1], u[0]]))  # distance of the slide's line from the axis
         spec = FollowerSpec(kind=FOLLOWER_TYPES["translating-roller"], roller_radius=15.0, eccentricity=e)
-        slide = Cam(program=program(lift), base_radius=50.0, follower=spec, rotation=rotation)
+        slide = Cam(program=program(lift), base_radius=50.0, follower_spec=spec, rotation=rotation)
         a, b = rocker.state(PHI), slide.state(PHI)
         errors.append(
             max(
@@ -209,10 +209,10 @@ def test_sizing_the_base_radius_and_the_pivot_against_a_scan() -> None:
             trial = (
                 replace(cam, base_radius=float(x))
                 if knob == "base_radius"
-                else replace(cam, follower=replace(cam.follower, pivot_distance=float(x)))
+                else replace(cam, follower_spec=replace(cam.follower_spec, pivot_distance=float(x)))
             )
             r0 = trial.base_radius + 15.0
-            d, arm = trial.follower.pivot_distance, 90.0
+            d, arm = trial.follower_spec.pivot_distance, 90.0
             if d is None or not (abs(d - arm) <= r0 <= d + arm):
                 continue
             margin = feasible_margins(trial, phi, max_pressure_angle=alpha, min_curvature_radius=0.0)[0]
