@@ -330,12 +330,12 @@ def _card(label: str, value: str, note: str = "", *, over: bool = False) -> str:
 
 def _cards(analysis: Analysis, k: Mapping[str, Any]) -> str:
     cam = analysis.cam
-    follower = cam.kinematics.describe()
+    follower = cam.follower.describe()
     alpha_over = k["alpha"] > k["alpha_limit"]
     alpha_note = f"limit {k['alpha_limit']:.2f}°"
     if k["alpha_at"] is not None:
         alpha_note += f", at φ = {k['alpha_at']:.1f}°"
-    if abs(k["alpha"]) < 1e-9 and not cam.has_pitch_curve and cam.kinematics.guide.pivot is None:
+    if abs(k["alpha"]) < 1e-9 and not cam.has_pitch_curve and cam.follower.guide.pivot is None:
         alpha_note = "always 0°: the face is square to its slide"
     rho_note = (
         f"convex profile, at φ = {k['rho_at']:.1f}°"
@@ -444,8 +444,8 @@ def _design_table(analysis: Analysis) -> str:
     rows = [
         ("follower type", design.follower.kind.word),
         ("base radius [mm]", _num(spec.base_radius)),
-        ("follower", _e(cam.kinematics.describe())),
-        *((label, _DASH if value is None else _num(value)) for label, value in cam.kinematics.rows()),
+        ("follower", _e(cam.follower.describe())),
+        *((label, _DASH if value is None else _num(value)) for label, value in cam.follower.rows()),
         ("rotation", spec.rotation.value),
         ("speed [rpm]", _num(spec.speed_rpm)),
         ("thickness [mm]", _num(spec.thickness)),
@@ -605,7 +605,7 @@ def render_report(analysis: Analysis) -> str:
     version = summary.get("camcad_version", "")
     sub = [
         f"source: {source}" if source else "",
-        analysis.cam.kinematics.describe(),
+        analysis.cam.follower.describe(),
         f"speed {analysis.design.cam.speed_rpm:g} rpm",
     ]
     header = f"<header><h1>{_e(name)}</h1><p>{_e(' · '.join(s for s in sub if s))}</p></header>"

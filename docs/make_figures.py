@@ -89,7 +89,7 @@ def oscillating_convention() -> None:
     FigureCanvasAgg(fig)
     for k, stem in enumerate(("packaging_rocker", "rocker_flat")):
         cam = Cam.from_design(load_design(ROOT / "samples" / f"{stem}.toml"))
-        follower = cam.kinematics
+        follower = cam.follower
         ax = fig.add_subplot(1, 2, k + 1)
         t = np.linspace(0, 2 * np.pi, 200)
         rb = cam.base_radius

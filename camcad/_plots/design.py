@@ -155,7 +155,7 @@ def curvature_plot(analysis: Analysis) -> Plot:
     phi = np.degrees(geo.phi)
     curves = [(geo.profile, "cam profile")]
     circle = cam.has_pitch_curve  # a flat face's reference trace has no curvature limit of its own
-    words = cam.kinematics.words
+    words = cam.follower.words
     if circle:
         curves.insert(0, (geo.pitch, trace_name(analysis)))
     series = []
@@ -260,7 +260,7 @@ def follower_drawings(analysis: Analysis, reach: float, *, cam: Cam | None = Non
     cam = analysis.cam if cam is None else cam
     phis = np.radians(np.asarray(FOLLOWER_ANGLES_DEG))
     out = []
-    for phi, sketch in zip(phis, cam.kinematics.sketch(cam.motion(phis), size=reach), strict=True):
+    for phi, sketch in zip(phis, cam.follower.sketch(cam.motion(phis), size=reach), strict=True):
 
         def seen(points: np.ndarray, phi: float = phi) -> np.ndarray:
             return to_cam(np.full(len(points), phi), np.asarray(points, dtype=float), cam.sigma)
@@ -387,7 +387,7 @@ def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
         key="profile",
         title="Cam profile (to scale)",
         caption=f"Cam frame at φ = 0 (follower on +y, cam turning {cam.rotation.value}): "
-        f"{cam.kinematics.describe()}, drawn where it meets the cam at φ = "
+        f"{cam.follower.describe()}, drawn where it meets the cam at φ = "
         + ", ".join(f"{a:g}°" for a in FOLLOWER_ANGLES_DEG)
         + " (kinematic inversion)."
         + family_caption(analysis),

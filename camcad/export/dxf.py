@@ -421,7 +421,7 @@ def _annotation_lines(cam: Cam, plate: Plate, curves: Sequence[DxfCurve]) -> lis
         sizes += f", bore dia {2.0 * bore.radius:.3f} mm"
         if bore.has_keyway:
             sizes += f", keyway {bore.keyway_width:.3f} x {bore.keyway_depth:.3f} mm"
-    who = cam.kinematics.describe()
+    who = cam.follower.describe()
     if follower.kind.face and follower.face_width is not None:
         who += f", face width {follower.face_width:.3f} mm"
     who = f"follower {follower.kind.word}: {who}, rotation {cam.rotation.value}"

@@ -110,7 +110,7 @@ class Cam:
         r_b [mm]: the smallest radius of the cam profile.
     follower_spec
         The design's ``[follower]`` table (kind, roller radius r_f [mm],
-        offset e [mm]); the follower it builds is :attr:`kinematics`.
+        offset e [mm]); the follower it builds is :attr:`follower`.
     rotation
         ``CCW`` (default) or ``CW``.
 
@@ -149,14 +149,14 @@ class Cam:
     # -- basic quantities -------------------------------------------------
 
     @property
-    def kinematics(self) -> Follower:
+    def follower(self) -> Follower:
         """The follower module at this cam's base radius (the tied roller on a pair's second plate).
 
         Built once per cam: every evaluation of the cam's curves asks for it.
         """
-        if "kinematics" not in self._memo:
-            self._memo["kinematics"] = self._follower()
-        out: Follower = self._memo["kinematics"]
+        if "follower" not in self._memo:
+            self._memo["follower"] = self._follower()
+        out: Follower = self._memo["follower"]
         return out
 
     def _follower(self) -> Follower:
@@ -192,12 +192,12 @@ class Cam:
         undercut makes it loop; a flat face's envelope is the profile itself,
         and undercut makes a cusp.
         """
-        return self.kinematics.roller_radius > 0.0
+        return self.follower.roller_radius > 0.0
 
     @property
     def roller_radius(self) -> float:
         """The contact circle's radius [mm] (a roller's r_f, a curved face's radius); 0 for a flat face."""
-        return self.kinematics.roller_radius
+        return self.follower.roller_radius
 
     @property
     def eccentricity(self) -> float:
@@ -252,7 +252,7 @@ class Cam:
 
     def _element(self, phi: ArrayLike, side: Side) -> tuple[Motion, PointElement | LineElement]:
         m = self.motion(phi, side=side)
-        return m, self.kinematics.element(m)
+        return m, self.follower.element(m)
 
     def pitch(self, phi: ArrayLike, *, side: Side = "right") -> CurveSample:
         """The pitch curve at cam angles φ [rad].
@@ -262,7 +262,7 @@ class Cam:
         follower axis). ``side`` picks the one-sided limit at joints.
         """
         m = self.motion(phi, side=side)
-        return point_envelope(m.phi, self.kinematics.trace(m), self.sigma)[0]
+        return point_envelope(m.phi, self.follower.trace(m), self.sigma)[0]
 
     def _base_curve(self, phi: ArrayLike, side: Side) -> tuple[CurveSample, FloatArray, float]:
         """The curve offsets are taken from, its dρ/dφ, and the profile's distance from it [mm].
@@ -327,7 +327,7 @@ class Cam:
             base, drho = line_envelope(m.phi, element, self.sigma)
             profile = base
             driven = profile.point
-        guide = self.kinematics.guide
+        guide = self.follower.guide
         driven_machine = to_cam(m.phi, driven, -self.sigma)
         alpha = pressure_angle(m.phi, profile.normal, driven_machine, guide, self.sigma)
         contact = to_cam(m.phi, profile.point, -self.sigma)
@@ -336,7 +336,7 @@ class Cam:
             arm = driven_machine - np.asarray(guide.pivot)
             lever = np.hypot(arm[:, 0], arm[:, 1])
             readonly(lever)
-        position = self.kinematics.contact_position(contact, m)
+        position = self.follower.contact_position(contact, m)
         readonly(position)
         return CamState(
             lever=lever,
@@ -371,7 +371,7 @@ class Cam:
         picks the one-sided limit at joints.
         """
         profile, driven = self._driven_point(phi, side)
-        return pressure_angle(profile.phi, profile.normal, driven, self.kinematics.guide, self.sigma)
+        return pressure_angle(profile.phi, profile.normal, driven, self.follower.guide, self.sigma)
 
     def contact_offset(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
         """Where the contact sits on the follower [mm] (:meth:`Follower.contact_position`).
@@ -385,7 +385,7 @@ class Cam:
         m = self.motion(phi, side=side)
         profile = self.profile(phi, side=side)
         contact = to_cam(profile.phi, profile.point, -self.sigma)
-        out = self.kinematics.contact_position(contact, m)
+        out = self.follower.contact_position(contact, m)
         readonly(out)
         return out
 

@@ -301,7 +301,7 @@ def analyse_geometry(
         findings.append(_pressure_finding(phi, alpha, alpha_max, max_pressure_angle))
     face_min = None
     if cam.follower_spec.kind.face:
-        check = _face_check if cam.kinematics.guide.pivot is None else _arm_face_check
+        check = _face_check if cam.follower.guide.pivot is None else _arm_face_check
         face_min, found = check(reach_min, reach_max, face_width, face_margin)
         findings += found
 
@@ -365,7 +365,7 @@ def _pivot_clearance(cam: Cam, radius_max: Extreme) -> list[Finding]:
     swept disc. Allowed: d > R_max, a strict bound with no hub size added
     (the design states none).
     """
-    pivot = cam.kinematics.guide.pivot
+    pivot = cam.follower.guide.pivot
     if pivot is None:
         return []
     d = math.hypot(*pivot)
@@ -402,7 +402,7 @@ def conjugate_overlap(partner: Cam) -> tuple[str, str] | None:
     2l·sin(θ/2) (the chord of the arm's circle of radius l). Seen along the
     shaft, the rollers overlap when that distance is below r_f + r_f2.
     """
-    tied = partner.kinematics
+    tied = partner.follower
     conj = partner.conjugate
     if conj is None or not isinstance(tied, TiedRoller):
         return None
@@ -613,7 +613,7 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
     suggestion = math.ceil(sized.base_radius / _SUGGEST_ROUND_MM) * _SUGGEST_ROUND_MM
     where = format_ranges(list(uc.ranges))
     if cam.has_pitch_curve:
-        words = cam.kinematics.words
+        words = cam.follower.words
         what = (
             f"undercut at {where}: the pitch curve's convex radius of curvature falls to "
             f"{uc.worst:.3f} mm {uc.where()}, below the {words.radius} "
@@ -623,7 +623,7 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
     else:
         what = (
             f"cusp at {where}: the profile radius of curvature "
-            f"{'r_b + s + a ' if cam.kinematics.guide.pivot is None else ''}falls to "
+            f"{'r_b + s + a ' if cam.follower.guide.pivot is None else ''}falls to "
             f"{uc.worst:.3f} mm {uc.where()}"
         )
         way_out = "or use a gentler motion law"

@@ -178,7 +178,7 @@ def mount_of(cam: Cam) -> Mount:
     """
     if cam.conjugate is not None:
         raise DesignError("tolerance", "a conjugate pair's second plate is not supported; analyse the first")
-    kin = cam.kinematics
+    kin = cam.follower
     guide = kin.guide
     m = cam.motion(np.array([0.0]))
     element = kin.element(m)

@@ -180,7 +180,7 @@ def min_base_radius(
     is returned.
     """
     phi = cam.sample_phi(step)
-    if cam.kinematics.guide.pivot is not None:  # an arm
+    if cam.follower.guide.pivot is not None:  # an arm
         return _arm_search(cam, phi, "base_radius", max_pressure_angle, min_curvature_radius, conjugate)
     lo = max(abs(cam.eccentricity) - cam.roller_radius, 0.0) + _RADIUS_TOL_MM
 
@@ -260,7 +260,7 @@ def min_pivot_distance(
 
     See :func:`min_base_radius` for the limits and :func:`_arm_search` for the search.
     """
-    if cam.kinematics.guide.pivot is None:
+    if cam.follower.guide.pivot is None:
         raise DesignError("follower.type", "sizing the pivot distance needs an oscillating follower")
     phi = cam.sample_phi(step)
     return _arm_search(cam, phi, "pivot_distance", max_pressure_angle, min_curvature_radius, conjugate)

@@ -103,7 +103,7 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
         "rotation": cam.rotation.value,
         "caption": f"To scale, cam frame at φ = 0, turning {cam.rotation.value}: the profile (filled), the "
         f"{trace_name(analysis)} (dashed), the base circle r = {cam.base_radius:g} mm (dotted) and "
-        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°." + family_caption(analysis),
+        f"{cam.follower.describe()} at φ = 0°, 90°, 180°, 270°." + family_caption(analysis),
         "profile_radius_max": float(np.hypot(*profile.T).max()),
     }
 
@@ -130,7 +130,7 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
 
     rho = one("cam profile", geo.profile.rho, clip)
     if cam.has_pitch_curve:
-        rho = one(cam.kinematics.words.path, geo.pitch.rho, clip) + rho
+        rho = one(cam.follower.words.path, geo.pitch.rho, clip) + rho
     roller = [cam.roller_radius] if cam.has_pitch_curve else []
     stress_limits = [] if spec.allowable_stress is None else [spec.allowable_stress]
     charts = [

@@ -58,7 +58,7 @@ PHI = np.linspace(0.0, 2.0 * math.pi, 181, endpoint=False) + 0.013
 @pytest.mark.parametrize("rotation", ROTATIONS)
 def test_roller_convention_and_pitch_on_the_arm_circle(rotation: Rotation) -> None:
     cam = roller_cam(rotation)
-    k = cam.kinematics
+    k = cam.follower
     pivot = np.asarray(k.pivot)
     # the convention: roller centre on +y at r_b + r_f at φ = 0, pivot to its right at d and l
     start = cam.pitch(np.array([0.0])).point[0]
@@ -94,7 +94,7 @@ def test_profile_at_roller_radius_from_the_pitch_curve(rotation: Rotation) -> No
 def test_roller_pressure_angle_closed_form_and_vectors(rotation: Rotation) -> None:
     cam = roller_cam(rotation)
     st = cam.state(PHI)
-    k = cam.kinematics
+    k = cam.follower
     beta = k.arm_angle(st.motion)
     dpsi = np.radians(st.motion.v)
     d, arm = 120.0, 90.0
@@ -136,7 +136,7 @@ def test_flat_contact_and_curvature_closed_forms(rotation: Rotation) -> None:
     st = cam.state(PHI)
     m = st.motion
     dpsi, ddpsi = np.radians(m.v), np.radians(m.a)
-    px, py = cam.kinematics.pivot
+    px, py = cam.follower.pivot
     # β: the angle between the line pivot → cam axis and the face
     beta = np.radians(m.s) + math.atan2(py, px)
     sense = 1.0 if rotation is Rotation.CCW else -1.0  # the face turns against a ccw cam
@@ -150,7 +150,7 @@ def test_flat_contact_and_curvature_closed_forms(rotation: Rotation) -> None:
 def test_flat_contact_is_the_limit_of_neighbouring_face_lines(rotation: Rotation) -> None:
     """The contact point as the intersection of the face lines at φ ± h (a numerical envelope)."""
     cam = flat_cam(rotation)
-    k = cam.kinematics
+    k = cam.follower
     h = 1e-6
     for phi in PHI[::10]:
         lines = []
@@ -171,7 +171,7 @@ def test_a_very_long_arm_becomes_a_slide(rotation: Rotation) -> None:
     for arm in (2.0e3, 2.0e4, 2.0e5):
         swing = math.degrees(lift / arm)  # the roller travels lift mm along its arc
         rocker = roller_cam(rotation, d=arm + delta, arm=arm, lift=swing)
-        k = rocker.kinematics
+        k = rocker.follower
         start = np.array([0.0, 65.0])
         u = -np.array([-(start - k.pivot)[1], (start - k.pivot)[0]]) / arm  # driven direction at ψ = 0
         e = -float(start @ np.array([-u[1], u[0]]))  # distance of the slide's line from the axis
