@@ -1,15 +1,15 @@
 """The outcome of a dynamic analysis: per-sample arrays and the summary numbers.
 
 No file I/O here: :meth:`DynamicsResult.summary` gives the ``dynamics``
-section of ``summary.json`` and :meth:`DynamicsResult.csv_rows` the rows of
-``dynamics.csv``, both for the pipeline to write.
+section of ``summary.json`` for the pipeline to write (``dynamics.csv`` is
+written from the arrays by :func:`camcad.export.tables.write_dynamics_csv`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -19,11 +19,7 @@ from camcad.dynamics.spec import DynamicsModel
 from camcad.extremes import SIDE_WORDS, Extreme
 from camcad.findings import Finding
 
-__all__ = ["CSV_HEADER", "FLANK_WORDS", "DynamicsResult"]
-
-CSV_HEADER = ("angle_deg", "contact_force_N", "torque_Nmm", "hertz_stress_MPa")
-"""Column names of ``dynamics.csv``."""
-
+__all__ = ["FLANK_WORDS", "DynamicsResult"]
 
 FLANK_WORDS = ("inner", "outer")
 """A groove's flanks: the inner drives where the contact force is positive, the outer where negative."""
@@ -121,8 +117,6 @@ class DynamicsResult:
     flank_force_max: tuple[Extreme, Extreme] | None = None
     flank_stress_max: tuple[Extreme, Extreme] | None = None
 
-    csv_header: ClassVar[tuple[str, ...]] = CSV_HEADER
-
     @property
     def jump(self) -> bool:
         """Whether the contact force falls below the margin anywhere."""
@@ -198,29 +192,3 @@ class DynamicsResult:
         if self.flank_stress_max is None:
             return None
         return FLANK_WORDS[0 if self.flank_stress_max[0].value >= self.flank_stress_max[1].value else 1]
-
-    def table(self) -> FloatArray:
-        """(n, 4) array of the ``dynamics.csv`` columns (see ``csv_header``).
-
-        Returns
-        -------
-        FloatArray
-            Columns: angle [deg], contact force [N], torque [N·mm], Hertz stress [MPa].
-        """
-        out = np.column_stack((np.degrees(self.phi), self.contact_force, self.torque, self.hertz_stress))
-        out.flags.writeable = False
-        return out
-
-    def csv_rows(self) -> list[tuple[str, ...]]:
-        """Rows of ``dynamics.csv``, the header first, numbers in a fixed format.
-
-        Returns
-        -------
-        list[tuple[str, ...]]
-            ``("angle_deg", ...)`` then one row per sample, every number with
-            6 decimals, ready for :func:`csv.writer`.
-        """
-        rows: list[tuple[str, ...]] = [CSV_HEADER]
-        for angle, force, torque, stress in self.table():
-            rows.append((f"{angle:.6f}", f"{force:.6f}", f"{torque:.6f}", f"{stress:.6f}"))
-        return rows

@@ -73,11 +73,6 @@ class GeometryAnalysis:
     # smallest concave profile radius [mm] (positive), a loop or cusp not counted; None if none
     concave_radius_min: Extreme | None
 
-    @property
-    def profile_radius(self) -> FloatArray:
-        """(n,) polar radius of the contact point [mm]."""
-        return np.hypot(self.profile.point[:, 0], self.profile.point[:, 1])
-
     def summary(self) -> dict[str, Any]:
         """The ``geometry`` section of summary.json (angles in degrees, lengths mm).
 
