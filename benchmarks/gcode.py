@@ -53,7 +53,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def uniform_chords(cam: Cam, radius: float, tol: float) -> int:
-    """Fewest uniform φ-steps whose chords of cam.offset(φ, radius) stay within ``tol`` [mm]."""
+    """Fewest uniform φ-steps whose chords of cam.offset_curve(φ, radius) stay within ``tol`` [mm]."""
     curve = offset_curve(cam, radius)
 
     def fits(n: int) -> bool:
@@ -73,7 +73,7 @@ def uniform_chords(cam: Cam, radius: float, tol: float) -> int:
 
 
 def fewest_arcs(cam: Cam, radius: float, band: float, n: int = 200_000) -> float:
-    """Asymptotic fewest arcs N ≈ ∫ (|κ'| / (72√3 ε))^{1/3} ds of cam.offset(φ, radius) for a band ε [mm]."""
+    """Fewest arcs N ≈ ∫ (|κ'| / (72√3 ε))^{1/3} ds of cam.offset_curve(φ, radius) for a band ε [mm]."""
     curve = offset_curve(cam, radius)
 
     def curvature(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

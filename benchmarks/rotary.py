@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def uniform_blocks(cam: Cam, radius: float, tolerance: float) -> int:
     """Fewest equal turn steps whose written X–θ spiral stays within ``tolerance`` (radial gap)."""
     phi = np.linspace(0.0, 2.0 * math.pi, 72_001)
-    q = cam.offset(phi, radius).point
+    q = cam.offset_curve(phi, radius).point
     r = np.hypot(q[:, 0], q[:, 1])
     turn = np.unwrap(-np.arctan2(q[:, 1], q[:, 0]))
 

@@ -13,7 +13,7 @@ Run ``python benchmarks/toolpath.py --out DIR`` to plan every shipped sample
 - ``finish_dev``: the planner's measured two-way deviation of the finishing contour [mm];
 - ``finish_hausdorff``, ``rough_hausdorff``: the two-way distance of the
   written finishing and (last) roughing contour to their exact offset curves
-  ``cam.offset(φ, r)`` and ``cam.offset(φ, r + stock)``, measured from the
+  ``cam.offset_curve(φ, r)`` and ``cam.offset_curve(φ, r + stock)``, measured from the
   moves alone by :mod:`camcad.toolpath.verify` [mm];
 - ``min_clearance``: the smallest clearance of the tool from the exact profile [mm].
 

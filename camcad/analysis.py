@@ -155,7 +155,7 @@ class Analysis:
 
     @property
     def findings(self) -> tuple[Finding, ...]:
-        """Every broken limit of every stage and part, hard ones first (see :mod:`camcad.findings`)."""
+        """Every finding of every stage and part: hard, soft, then notes (:mod:`camcad.findings`)."""
         first, *later = self.parts
         found = (
             *first.geometry.findings,
@@ -168,21 +168,12 @@ class Analysis:
             *(self.drive.findings if self.drive is not None else ()),
             *(self.vibration.findings if self.vibration is not None else ()),
         )
-        return tuple(sorted(found, key=lambda f: not f.hard))
-
-    @property
-    def warnings(self) -> list[str]:
-        """Every non-fatal message of every stage: soft findings and notes."""
-        fea = list(self.fea.warnings) if self.fea is not None else []
-        duty = [f.message for f in self.duty.findings] if self.duty is not None else []
-        duty += [f.message for f in self.drive.findings] if self.drive is not None else []
-        vib = [f.message for f in self.vibration.findings if not f.hard] if self.vibration is not None else []
-        return [*self.geometry.warnings, *self.dynamics.warnings, *fea, *duty, *vib]
+        return tuple(sorted(found, key=lambda f: f.rank))
 
     @property
     def violations(self) -> list[str]:
-        """The kinds of the broken limits, hard and soft (``camcad check`` exits 3 when any)."""
-        return list(dict.fromkeys(f.kind for f in self.findings))
+        """The kinds of the broken limits, hard and soft, not notes (``camcad check`` exits 3 when any)."""
+        return list(dict.fromkeys(f.kind for f in self.findings if not f.note))
 
     def summary(self) -> dict[str, Any]:
         """The content of ``summary.json``; a new dict on each call, the caller's to change.
@@ -213,7 +204,6 @@ class Analysis:
             out |= self.drive.summary()  # the train's drive
         if self.vibration is not None:
             out["vibration"] = self.vibration.summary()
-        out["warnings"] = self.warnings
         out["violations"] = self.violations
         out["findings"] = [f.summary() for f in self.findings]
         return out
@@ -230,7 +220,7 @@ def motion_summary(cam: Cam, motion: Motion) -> dict[str, Any]:
     Where the velocity jumps (``velocity_jumps_deg``) the acceleration is an
     impulse: the peaks of |a| and |j| are infinite and reported as ``None``.
     """
-    u = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    u = cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     out: dict[str, Any] = {f"lift_{u}": cam.program.lift}
     joints = [bp.phi for bp in cam.program.breakpoints]
     # where v jumps, a is an impulse and j is undefined: their peaks are infinite, not the samples'

@@ -447,7 +447,7 @@ class Result:
 
     @property
     def findings(self) -> tuple[Finding, ...]:
-        """Every broken limit of every stage, hard ones first (``camcad.findings.Finding``)."""
+        """Every broken limit of every stage, hard ones first, then notes (``camcad.findings.Finding``)."""
         return self.analysis.findings
 
     @property
@@ -563,7 +563,8 @@ class Result:
         from camcad.report import key_numbers_html
 
         items = "".join(
-            f"<li>{'hard' if f.hard else 'soft'} limit: {_e(f.message)}</li>" for f in self.findings
+            f"<li>{'note' if f.note else f.severity.value + ' limit'}: {_e(f.message)}</li>"
+            for f in self.findings
         )
         verdict = (
             f'<p class="camcad-ok">{_e(self.design.name)}: all design limits hold</p>'
@@ -640,7 +641,7 @@ def optimize(
     points: int = 7,
     progress: Callable[[str], None] | None = None,
 ) -> OptimizeResult:
-    """Constrained optimisation over design-file keys, as ``camcad optimize`` does.
+    """Constrained optimization over design-file keys, as ``camcad optimize`` does.
 
     Parameters
     ----------

@@ -6,6 +6,12 @@ class attribute ``exit_code`` and :func:`exit_code` maps any exception.
 a bad command-line option; ``OutputError`` is an output file or folder that
 cannot be written (exit 2); ``DesignLimitError`` is a valid design that breaks
 a limit the user cannot ignore, such as undercut or gouge (exit 3).
+
+Every error carries the design field it concerns as data, ``field`` (a TOML
+path such as ``cam.base_radius``, an option such as ``--output``, or empty),
+set by the caller that knows the path; its text names it (in front,
+``"cam.base_radius: undercut at …"``, unless the message names it already),
+so nothing reads it back out of a message.
 """
 
 from __future__ import annotations
@@ -66,13 +72,46 @@ def printable(text: str) -> str:
 
 
 class CamcadError(Exception):
-    """Base class for all camcad errors (its text is one line: control characters escaped)."""
+    """Base class for all camcad errors (its text is one line: control characters escaped).
+
+    Parameters
+    ----------
+    *args
+        The message (as for :class:`Exception`).
+    field
+        The design field (TOML path) or command-line option the error
+        concerns, empty when none; the text starts with it.
+    """
 
     exit_code: int = EXIT_UNEXPECTED
+    field: str = ""
+
+    def __init__(self, *args: object, field: str = "") -> None:
+        super().__init__(*args)
+        self.field = field
 
     def __str__(self) -> str:
-        """The message with control characters escaped (:func:`printable`)."""
-        return printable(super().__str__())
+        """``field: message`` with control characters escaped (:func:`printable`).
+
+        The field is put in front unless the message names it already (a
+        limit's message that names its field for the report too).
+        """
+        text = super().__str__()
+        if self.field and self.field not in text:
+            text = f"{self.field}: {text}"
+        return printable(text)
+
+    @property
+    def message(self) -> str:
+        """What is wrong, without the field in front (``field`` holds it)."""
+        text = str(self.args[0]) if self.args else ""
+        return text.removeprefix(f"{self.field}: ") if self.field else text
+
+    def with_field(self, field: str) -> CamcadError:
+        """Name ``field`` unless a field is named already (a caller that knows the TOML path)."""
+        if not self.field:
+            self.field = field
+        return self
 
 
 class DesignError(CamcadError, ValueError):
@@ -81,15 +120,24 @@ class DesignError(CamcadError, ValueError):
     Parameters
     ----------
     path
-        Field path such as ``motion[2].angle`` (empty for file-level errors).
+        Field path such as ``motion[2].angle`` (empty for file-level errors),
+        kept as ``field``.
     message
         What is wrong, with the value and what is allowed.
     """
 
     def __init__(self, path: str, message: str) -> None:
-        self.path = path
-        self.message = message
-        super().__init__(f"{path}: {message}" if path else message)
+        super().__init__(message, field=path)
+
+    def __str__(self) -> str:
+        """``path: message``, always in that form (escaped, :func:`printable`)."""
+        text = str(self.args[0]) if self.args else ""
+        return printable(f"{self.field}: {text}" if self.field else text)
+
+    @property
+    def path(self) -> str:
+        """The field path (``field``; this older name stays for callers that use it)."""
+        return self.field
 
     exit_code = EXIT_INVALID
 
@@ -139,6 +187,7 @@ class OutputError(CamcadError, OSError):
         self.problem = problem
         self.advice = advice
         super().__init__(f"--output: cannot write {self.path}: {problem}" + (f"; {advice}" if advice else ""))
+        self.field = "--output"  # the text names it already (``__str__`` below)
         self.filename = self.path
 
     def __str__(self) -> str:
@@ -170,8 +219,9 @@ class UndercutError(DesignLimitError):
         phi_range: tuple[float, float],
         worst: float,
         suggested_base_radius: float | None,
+        field: str = "",
     ) -> None:
-        super().__init__(message)
+        super().__init__(message, field=field)
         self.phi_range = phi_range
         self.worst = worst
         self.suggested_base_radius = suggested_base_radius
@@ -180,8 +230,10 @@ class UndercutError(DesignLimitError):
 class GougeError(DesignLimitError):
     """The milling tool is larger than a concave radius of the profile."""
 
-    def __init__(self, message: str, *, phi_range: tuple[float, float], max_tool_radius: float) -> None:
-        super().__init__(message)
+    def __init__(
+        self, message: str, *, phi_range: tuple[float, float], max_tool_radius: float, field: str = ""
+    ) -> None:
+        super().__init__(message, field=field)
         self.phi_range = phi_range
         self.max_tool_radius = max_tool_radius
 
@@ -189,8 +241,8 @@ class GougeError(DesignLimitError):
 class FitError(DesignLimitError):
     """The NURBS fit cannot meet the tolerance within the control-point budget (a hard limit)."""
 
-    def __init__(self, message: str, *, best_error: float, control_point_count: int) -> None:
-        super().__init__(message)
+    def __init__(self, message: str, *, best_error: float, control_point_count: int, field: str = "") -> None:
+        super().__init__(message, field=field)
         self.best_error = best_error
         self.control_point_count = control_point_count
 

@@ -1,9 +1,10 @@
-"""Typed findings: what an analysis found wrong with a design, made once, rendered everywhere.
+"""Typed findings: what an analysis found about a design, made once, rendered everywhere.
 
-A :class:`Finding` is a broken limit with the design field that controls it,
-the value reached, the limit and one sentence for a person. Every stage
-reports its findings this way; the CLI, the report and ``summary.json`` render
-them, and one rule decides what stops a build:
+A :class:`Finding` is a broken limit (or a note) with the design field that
+controls it, the value reached, the limit and one sentence for a person. Every
+stage reports its messages this way, and only this way (no free warning
+strings); the CLI, the report and ``summary.json`` render them, and one rule
+decides what stops a build:
 
 - **hard** limits make the part unusable (undercut, a flat face narrower than
   the contact's travel, a velocity jump, gouge, an unreachable fit
@@ -11,7 +12,10 @@ them, and one rule decides what stops a build:
 - **soft** limits are engineering judgement (pressure angle, contact stress,
   follower jump): ``build`` writes the files and lists them as warnings, and
   ``build --strict`` turns them into exit 3;
-- ``check`` exits 3 on either.
+- ``check`` exits 3 on either;
+- **notes** are neither: what a person should know about the result (a
+  model's assumption that does not hold everywhere, an FE load case left
+  out). They never change an exit code.
 """
 
 from __future__ import annotations
@@ -25,20 +29,21 @@ __all__ = ["Finding", "Severity"]
 
 
 class Severity(enum.Enum):
-    """Whether a broken limit stops a build (hard) or is a warning (soft)."""
+    """Whether a finding stops a build (hard), is a broken soft limit (soft) or only informs (note)."""
 
     HARD = "hard"
     SOFT = "soft"
+    NOTE = "note"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Finding:
-    """One broken design limit.
+    """One broken design limit, or a note about the result.
 
     Attributes
     ----------
     kind
-        What broke, e.g. ``"undercut"``, ``"pressure angle"``.
+        What broke, e.g. ``"undercut"``, ``"pressure angle"`` (a note: what it is about).
     severity
         :class:`Severity`.
     field
@@ -67,6 +72,16 @@ class Finding:
         """Whether this finding stops a build."""
         return self.severity is Severity.HARD
 
+    @property
+    def note(self) -> bool:
+        """Whether this finding only informs: no limit is broken, no exit code changes."""
+        return self.severity is Severity.NOTE
+
+    @property
+    def rank(self) -> int:
+        """Sort key: hard findings first, then soft, then notes."""
+        return _RANK[self.severity]
+
     def summary(self) -> dict[str, Any]:
         """JSON-ready dict for ``summary.json`` (angle in degrees)."""
         return {
@@ -79,3 +94,6 @@ class Finding:
             "unit": self.unit,
             "message": self.message,
         }
+
+
+_RANK = {Severity.HARD: 0, Severity.SOFT: 1, Severity.NOTE: 2}

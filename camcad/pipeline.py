@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import pickle
-import re
 import signal
 import sys
 import time
@@ -151,7 +150,7 @@ def analyse(
         vibration = _timed(timings, progress, "vibration", lambda: _vibration(design, cam))
         stop = [f for f in vibration.findings if f.hard]  # the follower leaves a spring-loaded cam
         if stop and strict:
-            raise DesignLimitError(f"{stop[0].field}: {stop[0].message}")
+            raise DesignLimitError(stop[0].message, field=stop[0].field)
         if vibration.compensated is not None:
             from camcad.dynamics.vibration import compensated_program
 
@@ -179,7 +178,7 @@ def analyse(
     if hard and strict:
         if geometries[0].undercut is not None:
             raise undercut_error(geometries[0], min_curvature_radius=design.min_curvature_radius)
-        raise DesignLimitError(hard[0].message)
+        raise DesignLimitError(hard[0].message, field=hard[0].field)
     setup = design.dynamics_setup()
 
     def setup_of(part: Part) -> DynamicsSetup:
@@ -187,13 +186,17 @@ def analyse(
         return replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius)
 
     def dynamics_of(part: Part, geometry: GeometryAnalysis) -> DynamicsResult:
-        return analyse_dynamics(
-            part.cam.motion(geometry.phi),
-            pressure_angle=geometry.pressure_angle,
-            profile_rho=geometry.profile.rho,
-            setup=setup_of(part),
-            cam=part.cam,
-        )
+        try:
+            return analyse_dynamics(
+                part.cam.motion(geometry.phi),
+                pressure_angle=geometry.pressure_angle,
+                profile_rho=geometry.profile.rho,
+                setup=setup_of(part),
+                cam=part.cam,
+            )
+        except DesignLimitError as err:  # the guided tappet self-locks (Hren et al. eq. 25)
+            err.with_field("dynamics.b_m")  # spread its guides
+            raise
 
     dynamics = _timed(
         timings,
@@ -355,7 +358,7 @@ _STAGE_LIMITS: dict[str, tuple[type[DesignLimitError], str, str]] = {
     "fit": (FitError, "fit tolerance", "fit.tolerance"),
     "toolpath": (GougeError, "gouge", "gcode.tool_diameter"),
 }
-"""The hard limit each later stage can break: its error, the finding's kind, the default field."""
+"""The hard limit each later stage can break: its error, the finding's kind, the field when it names none."""
 
 
 def _limited(
@@ -372,18 +375,11 @@ def _limited(
     try:
         return _timed(timings, progress, stage, run)
     except error as err:
+        err.with_field(field)  # the stage's own field when it named none
         if strict:
             raise
-        found.append(_hard_finding(kind, field, err))
+        found.append(Finding(kind=kind, severity=Severity.HARD, field=err.field, message=str(err)))
         return None
-
-
-def _hard_finding(kind: str, field: str, err: Exception) -> Finding:
-    """A hard finding for a limit error a later stage raised; its message starts with the field it names."""
-    named = str(err).split(":", 1)[0]
-    if re.fullmatch(r"[a-z_]+\.[a-z_]+", named):
-        field = named
-    return Finding(kind=kind, severity=Severity.HARD, field=field, message=str(err))
 
 
 def _groups(only: Iterable[str] | None) -> set[str]:
@@ -439,7 +435,7 @@ def build(
         analysis = analyse(
             design, fit=True, toolpath="gcode" in groups, progress=progress, fea="fea" in groups
         )
-        soft = [f for f in analysis.findings if not f.hard]
+        soft = [f for f in analysis.findings if f.severity is Severity.SOFT]
         if strict and soft:
             listed = "; ".join(f"{f.field}: {f.message}" for f in soft)
             raise DesignLimitError(f"--strict: {len(soft)} soft limit(s) broken: {listed}")
@@ -672,7 +668,7 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
     )
 
     cam, design = analysis.cam, analysis.design
-    unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    unit = cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     duty = analysis.duty.csv_columns() if analysis.duty is not None else {}  # the first part's film
     duty |= analysis.drive.csv_columns() if analysis.drive is not None else {}  # the train's motor torque
     motion_csv = write_motion_csv(folder / "motion.csv", cam, unit=unit)
@@ -713,7 +709,7 @@ def _drive_table(analysis: Analysis, folder: Path) -> list[Path]:
     options = analysis.design.tables
     if options.cam_table_points is None:
         return []
-    unit = analysis.cam.follower.kind.lift_unit
+    unit = analysis.cam.follower_spec.kind.lift_unit
     return [
         write_drive_table(
             folder / "cam_table.csv",

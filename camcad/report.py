@@ -34,7 +34,7 @@ from markupsafe import Markup
 from camcad._plots import Plot, compare_plots, report_plots
 from camcad._plots.compare import compare_colors
 from camcad.export.records import write_text
-from camcad.findings import Finding
+from camcad.findings import Finding, Severity
 from camcad.report_tables import (
     fmt,
     joint_rows,
@@ -168,7 +168,7 @@ def _finding_lines(findings: Sequence[Finding]) -> list[str]:
 def _jump_lines(analysis: Analysis, summary: Mapping[str, Any]) -> list[str]:
     """Banner lines for large acceleration jumps at motion joints (see :mod:`camcad.report_tables`)."""
     motion = summary.get("motion", {})
-    unit = analysis.cam.follower.kind.lift_unit
+    unit = analysis.cam.follower_spec.kind.lift_unit
     a_peak = motion.get(f"a_max_abs_{unit}_per_rad2")
     return large_acceleration_jumps(
         motion.get("joints", []),
@@ -182,9 +182,8 @@ def _jump_lines(analysis: Analysis, summary: Mapping[str, Any]) -> list[str]:
 def _alerts(analysis: Analysis, summary: Mapping[str, Any]) -> list[dict[str, Any]]:
     """The banner: hard limits, soft limits, then notes and large acceleration jumps (camcad.findings)."""
     hard = [f for f in analysis.findings if f.hard]
-    soft = [f for f in analysis.findings if not f.hard]
-    said = {f.message for f in analysis.findings}
-    notes = [w for w in analysis.warnings if w not in said] + _jump_lines(analysis, summary)
+    soft = [f for f in analysis.findings if f.severity is Severity.SOFT]
+    notes = [f.message for f in analysis.findings if f.note] + _jump_lines(analysis, summary)
     out = []
     if hard:
         out.append(_alert("bad", "Hard limits broken", _finding_lines(hard), anchor="violations"))
@@ -211,7 +210,7 @@ def _key_numbers(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, An
     dyn = summary.get("dynamics", {})
     fit = summary.get("fit")
     d = analysis.dynamics
-    unit = analysis.cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    unit = analysis.cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     return {
         "lift": analysis.cam.program.lift,
         "stroke": motion.get(f"stroke_{unit}"),  # the true travel, max − min of s
@@ -245,12 +244,12 @@ def _card(label: str, value: str, note: str = "", *, over: bool = False) -> dict
 
 def _cards(analysis: Analysis, k: Mapping[str, Any]) -> list[dict[str, Any]]:
     cam = analysis.cam
-    follower = cam.kinematics.describe()
+    follower = cam.follower.describe()
     alpha_over = k["alpha"] > k["alpha_limit"]
     alpha_note = f"limit {k['alpha_limit']:.2f}°"
     if k["alpha_at"] is not None:
         alpha_note += f", at φ = {k['alpha_at']:.1f}°"
-    if abs(k["alpha"]) < 1e-9 and not cam.has_pitch_curve and cam.kinematics.guide.pivot is None:
+    if abs(k["alpha"]) < 1e-9 and not cam.has_pitch_curve and cam.follower.guide.pivot is None:
         alpha_note = "always 0°: the face is square to its slide"
     rho_note = (
         f"convex profile, at φ = {k['rho_at']:.1f}°"
@@ -312,7 +311,7 @@ def _cards(analysis: Analysis, k: Mapping[str, Any]) -> list[dict[str, Any]]:
             f"{gcode.get('blocks')} blocks",
             f"{gcode.get('arcs')} arcs, about {minutes:.1f} min; {tool}",
         )
-    lift = cam.follower.kind.lift
+    lift = cam.follower_spec.kind.lift
     shown = lift.symbol
     stroke_note = ""
     if k["stroke"] is not None and round(k["stroke"], 3) != round(k["lift"], 3):  # a segment overshoots
@@ -348,7 +347,7 @@ def _program_table(analysis: Analysis) -> dict[str, Any]:
                 law,
             ]
         )
-    lift = f"lift [{analysis.cam.follower.kind.lift.short}]"
+    lift = f"lift [{analysis.cam.follower_spec.kind.lift.short}]"
     header = ["#", "segment", "start [°]", "span [°]", lift, "law"]
     return {"header": header, "rows": rows}
 
@@ -359,8 +358,8 @@ def _design_table(analysis: Analysis) -> list[list[str]]:
     rows = [
         ("follower type", design.follower.kind.word),
         ("base radius [mm]", _num(spec.base_radius)),
-        ("follower", cam.kinematics.describe()),
-        *((label, _DASH if value is None else _num(value)) for label, value in cam.kinematics.rows()),
+        ("follower", cam.follower.describe()),
+        *((label, _DASH if value is None else _num(value)) for label, value in cam.follower.rows()),
         ("rotation", spec.rotation.value),
         ("speed [rpm]", _num(spec.speed_rpm)),
         ("thickness [mm]", _num(spec.thickness)),
@@ -382,7 +381,7 @@ def _quantities_table(section: Mapping[str, Any], *, skip: Sequence[str] = ()) -
                 {
                     "title": label(key),
                     "records": None,
-                    "section": _quantities_table(value, skip=("warnings",)),
+                    "section": _quantities_table(value),
                 }
             )
         elif _is_records(value):
@@ -405,7 +404,7 @@ def _records_table(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
 
 
 _SECTION_TITLES = {"gcode": "G-code", "fit": "NURBS fit", "second_plate": "Second plate"}
-_NOT_TABLES = ("camcad_version", "design", "warnings", "violations", "findings")
+_NOT_TABLES = ("camcad_version", "design", "violations", "findings")
 
 
 def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str, Any]:
@@ -415,13 +414,13 @@ def _summary_tables(analysis: Analysis, summary: Mapping[str, Any]) -> dict[str,
         if name in _NOT_TABLES or not isinstance(section, Mapping):
             continue
         title = _SECTION_TITLES.get(name, name.replace("_", " ").capitalize())
-        body = _quantities_table(section, skip=("warnings", "joints"))
+        body = _quantities_table(section, skip=("joints",))
         sections.append({"name": name, "title": title, "body": body, "wide": _has_records(body)})
     motion = summary.get("motion", {})
     joints = motion.get("joints")
     table = None
     if joints:
-        unit = analysis.cam.follower.kind.lift_unit
+        unit = analysis.cam.follower_spec.kind.lift_unit
         header, rows = joint_rows(
             joints,
             unit=unit,
@@ -526,7 +525,7 @@ def render_report(analysis: Analysis) -> str:
     source = analysis.design.source
     sub = [
         f"source: {source}" if source else "",
-        analysis.cam.kinematics.describe(),
+        analysis.cam.follower.describe(),
         f"speed {analysis.design.cam.speed_rpm:g} rpm",
     ]
     plots = report_plots(analysis)
@@ -608,7 +607,7 @@ def compare_table(analyses: Sequence[Analysis]) -> list[list[str]]:
 
 def _lift_unit_text(analyses: Sequence[Analysis]) -> str:
     """The lift's unit of several designs as shown: ``mm`` (slides), ``°`` (arms) or ``mm or °``."""
-    units = {a.cam.follower.kind.lift.short for a in analyses}
+    units = {a.cam.follower_spec.kind.lift.short for a in analyses}
     return units.pop() if len(units) == 1 else "mm or °"
 
 
@@ -680,8 +679,8 @@ def render_compare(analyses: Sequence[Analysis]) -> str:
     table = compare_table(analyses)
     alerts = []
     for name, analysis in zip(names, analyses, strict=True):
-        said = {f.message for f in analysis.findings}
-        findings = [*_finding_lines(analysis.findings), *(w for w in analysis.warnings if w not in said)]
+        limits = [f for f in analysis.findings if not f.note]
+        findings = [*_finding_lines(limits), *(f.message for f in analysis.findings if f.note)]
         findings += _jump_lines(analysis, analysis.summary())
         if findings:
             alerts.append(_alert("bad" if analysis.violations else "warn", name, findings))

@@ -89,7 +89,7 @@ def oscillating_convention() -> None:
     FigureCanvasAgg(fig)
     for k, stem in enumerate(("packaging_rocker", "rocker_flat")):
         cam = Cam.from_design(load_design(ROOT / "samples" / f"{stem}.toml"))
-        follower = cam.kinematics
+        follower = cam.follower
         ax = fig.add_subplot(1, 2, k + 1)
         t = np.linspace(0, 2 * np.pi, 200)
         rb = cam.base_radius
@@ -105,7 +105,7 @@ def oscillating_convention() -> None:
         ax.plot([0, px], [0, py], color="0.3", lw=0.8, ls="--")
         ax.annotate("pivot", (px, py), textcoords="offset points", xytext=(6, 6))
         ax.annotate(
-            f"d = {cam.follower.pivot_distance:g}",
+            f"d = {cam.follower_spec.pivot_distance:g}",
             (px / 2, py / 2),
             textcoords="offset points",
             xytext=(4, -14),
@@ -113,7 +113,7 @@ def oscillating_convention() -> None:
         if cam.has_pitch_curve:
             centre = follower.element(cam.motion(np.array([0.0]))).m0[0]
             ax.annotate(
-                f"l = {cam.follower.arm_length:g}",
+                f"l = {cam.follower_spec.arm_length:g}",
                 (centre + np.array([px, py])) / 2,
                 textcoords="offset points",
                 xytext=(-10, -18),
@@ -129,7 +129,8 @@ def oscillating_convention() -> None:
                 textcoords="offset points",
                 xytext=(-90, -28),
             )
-            title = f"oscillating-flat: face {cam.follower.face_offset:g} mm below the pivot, a rise lifts it"
+            below = cam.follower_spec.face_offset
+            title = f"oscillating-flat: face {below:g} mm below the pivot, a rise lifts it"
         # the sense of a rise: the arm turns clockwise about the pivot
         ax.annotate(
             "",

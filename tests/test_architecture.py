@@ -48,7 +48,7 @@ LAYER_ORDER: tuple[frozenset[str], ...] = (
     frozenset({"design"}),  # the schema sits above every stage
     frozenset({"analysis", "report", "report_tables", "_plots"}),
     frozenset({"pipeline"}),
-    frozenset({"explore"}),  # camcad/explore/ (issue 20): optimise, sweep, Pareto; analyses through pipeline
+    frozenset({"explore"}),  # camcad/explore/ (issue 20): optimize, sweep, Pareto; analyses through pipeline
     # serve/ (issue 19): the live designer; api: the Python API (issue 39)
     frozenset({"cli", "serve", "api", "__init__", "__main__"}),
 )
@@ -397,7 +397,7 @@ def test_follower_kind_scan_flags_a_made_up_module():
             "7: FollowerKind",
         ]
     )
-    clean = "def f(cam):\n    return cam.has_pitch_curve and cam.follower.kind.lift.angular\n"
+    clean = "def f(cam):\n    return cam.has_pitch_curve and cam.follower_spec.kind.lift.angular\n"
     assert follower_kind_uses(ast.parse(clean), KNOWN_FOLLOWER_WORDS) == []
 
 

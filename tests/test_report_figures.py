@@ -43,7 +43,7 @@ def test_fit_error_within_certificate_and_knots_at_the_joints(built):
 
 
 def test_toolpath_layers_follow_the_exact_tool_centre_curve(built):
-    """Finishing moves lie within the certified deviation of cam.offset(φ, r_tool); leads and tabs counted."""
+    """Finishing moves lie within the certified deviation of cam.offset_curve(φ, r_tool), leads, tabs too."""
     path = built.toolpath
     layers = toolpath_layers(path)
     passes = len(path.levels) + 1
@@ -51,7 +51,7 @@ def test_toolpath_layers_follow_the_exact_tool_centre_curve(built):
     below = sum(1 for z in path.levels if z < path.tab_top) + 1 if path.tab_top is not None else 0
     assert len(layers["tab"]) >= path.spec.tab_count * below > 0
     phi = np.linspace(0, 2 * math.pi, 400_000, endpoint=False)
-    exact = np.asarray(built.cam.offset(phi, path.tool_radius).point)
+    exact = np.asarray(built.cam.offset_curve(phi, path.tool_radius).point)
     tree = cKDTree(exact)
     finish = np.vstack(layers["finishing"])
     dist, _ = tree.query(finish)

@@ -40,7 +40,7 @@ def test_second_rollers_are_drawn_on_the_second_plate() -> None:
     gap = distance_to_polygon(_centres(drawings), plate)
     assert np.abs(gap - analysis.design.conjugate.roller_radius).max() < 1e-3
     # each second roller hangs on its own arm from the pivot (seen from the turning cam)
-    pivot = np.asarray(analysis.cam.kinematics.guide.pivot)
+    pivot = np.asarray(analysis.cam.follower.guide.pivot)
     for drawing, phi in zip(drawings, np.radians([d.phi_deg for d in drawings]), strict=True):
         c, s = math.cos(phi), math.sin(phi)
         seen = np.array([c * pivot[0] + s * pivot[1], -s * pivot[0] + c * pivot[1]])  # R(−φ): a ccw cam

@@ -95,7 +95,7 @@ def closed(phi_deg: FloatArray, *values: FloatArray) -> tuple[FloatArray, ...]:
 
 def trace_name(analysis: Analysis) -> str:
     """What the follower's reference curve is, in words, for this follower type."""
-    return analysis.cam.kinematics.words.trace
+    return analysis.cam.follower.words.trace
 
 
 def shape(ax: Axes, patch: Patch) -> None:

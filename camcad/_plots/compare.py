@@ -73,7 +73,7 @@ def compare_plots(analyses: Sequence[Analysis], names: Sequence[str]) -> list[Pl
     The figures carry no legend (long names would cover the curves): the page
     shows one key for all of them, in :func:`compare_colors`.
     """
-    units = {a.cam.follower.kind.lift.short for a in analyses}
+    units = {a.cam.follower_spec.kind.lift.short for a in analyses}
     unit = units.pop() if len(units) == 1 else "mm or °"  # an arm's s, v, a are in degrees of swing
     quantities = [(k, t, label.replace("[mm", f"[{unit}"), get) for k, t, label, get in _QUANTITIES]
     return [_profiles(analyses, names), *(_curve(analyses, names, *q) for q in quantities)]

@@ -76,7 +76,7 @@ def motion_plot(analysis: Analysis) -> Plot:
     """s, v, a, j (or ψ and its derivatives for an arm) against the cam angle."""
     m = analysis.motion
     phi = np.degrees(m.phi)
-    labels = analysis.cam.follower.kind.lift.labels  # an arm's lift is its swing ψ, in degrees
+    labels = analysis.cam.follower_spec.kind.lift.labels  # an arm's lift is its swing ψ, in degrees
     values = (m.s, m.v, m.a, m.j)
     blends = analysis.cam.program.blend_points  # joints solved to match their neighbours (issue 16)
     blend_deg = np.degrees([b.phi for b in blends])
@@ -93,7 +93,7 @@ def motion_plot(analysis: Analysis) -> Plot:
         for k, (label, v) in enumerate(zip(labels, values, strict=True))
     ]
     bounds_deg, segments = _segments(analysis)
-    what = analysis.cam.follower.kind.lift.title
+    what = analysis.cam.follower_spec.kind.lift.title
     blend_note = (
         f"; ticks along the bottom mark the {len(blends)} blend points, where the laws meet continuous "
         + ("to the jerk" if smooth >= 3 else "to the acceleration" if smooth == 2 else f"to order {smooth}")
@@ -155,7 +155,7 @@ def curvature_plot(analysis: Analysis) -> Plot:
     phi = np.degrees(geo.phi)
     curves = [(geo.profile, "cam profile")]
     circle = cam.has_pitch_curve  # a flat face's reference trace has no curvature limit of its own
-    words = cam.kinematics.words
+    words = cam.follower.words
     if circle:
         curves.insert(0, (geo.pitch, trace_name(analysis)))
     series = []
@@ -260,7 +260,7 @@ def follower_drawings(analysis: Analysis, reach: float, *, cam: Cam | None = Non
     cam = analysis.cam if cam is None else cam
     phis = np.radians(np.asarray(FOLLOWER_ANGLES_DEG))
     out = []
-    for phi, sketch in zip(phis, cam.kinematics.sketch(cam.motion(phis), size=reach), strict=True):
+    for phi, sketch in zip(phis, cam.follower.sketch(cam.motion(phis), size=reach), strict=True):
 
         def seen(points: np.ndarray, phi: float = phi) -> np.ndarray:
             return cam.seen_from_cam(np.full(len(points), phi), np.asarray(points, dtype=float))
@@ -310,7 +310,7 @@ SECOND_PLATE = "#b5651d"
 def _draw_pocket(ax: Axes, analysis: Analysis, pocket: Pocket) -> None:
     """A part with a pocket seen from its face: the blank, the pocket (white) between its flanks."""
     cam, phi = analysis.cam, analysis.geometry.phi
-    inner, outer = (np.asarray(cam.offset(phi, flank.offset).point) for flank in pocket.flanks)
+    inner, outer = (np.asarray(cam.offset_curve(phi, flank.offset).point) for flank in pocket.flanks)
     shape(
         ax, Circle((0.0, 0.0), pocket.outer_radius, facecolor="#dbe6f1", edgecolor="#1f3b57", linewidth=1.2)
     )
@@ -395,7 +395,7 @@ def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
             key="profile",
             title="Cam profile (to scale)",
             caption=f"Bar frame at φ = 0 (follower on +y, bar sliding towards −x): "
-            f"{cam.kinematics.describe()}, drawn where it meets the bar at φ = "
+            f"{cam.follower.describe()}, drawn where it meets the bar at φ = "
             + ", ".join(f"{a:g}°" for a in FOLLOWER_ANGLES_DEG)
             + "."
             + family_caption(analysis),
@@ -421,7 +421,7 @@ def profile_plot(analysis: Analysis, *, size: float = 6.0) -> Plot:
         key="profile",
         title="Cam profile (to scale)",
         caption=f"Cam frame at φ = 0 (follower on +y, cam turning {cam.rotation.value}): "
-        f"{cam.kinematics.describe()}, drawn where it meets the cam at φ = "
+        f"{cam.follower.describe()}, drawn where it meets the cam at φ = "
         + ", ".join(f"{a:g}°" for a in FOLLOWER_ANGLES_DEG)
         + " (kinematic inversion)."
         + family_caption(analysis),

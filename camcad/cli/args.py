@@ -90,7 +90,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--open", action="store_true", help="open the page in the default browser")
     p.set_defaults(handler=_cmd_serve)
 
-    p = sub.add_parser("optimize", help="constrained optimisation over design-file keys, or a Pareto front")
+    p = sub.add_parser("optimize", help="constrained optimization over design-file keys, or a Pareto front")
     p.add_argument("design", help="design file (TOML)")
     p.add_argument(
         "--minimize",

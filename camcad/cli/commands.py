@@ -40,10 +40,10 @@ def _cmd_build(args: argparse.Namespace) -> int:
     if not args.quiet:
         print(f"camcad {__version__}: building {design.cam.name!r} from {args.design}", file=sys.stderr)
     result = build(design, args.output, only=only, progress=_progress(args.quiet), strict=args.strict)
-    warnings = result.analysis.warnings
     if not args.quiet:
-        for w in warnings:
-            print(f"warning: {w}", file=sys.stderr)
+        for f in result.analysis.findings:
+            if not f.hard:  # a hard one stopped the build before it wrote anything
+                print(f"{'note' if f.note else 'warning'}: {f.message}", file=sys.stderr)
         print(f"wrote {len(result.files)} files to {result.outdir}", file=sys.stderr)
         for path in result.files:
             print(f"  {path}")
@@ -80,12 +80,9 @@ def _cmd_check(args: argparse.Namespace) -> int:
     print(f"{design.cam.name} ({args.design})")
     for key, value in rows:
         print(f"  {key:<{width}}  {value}")
-    limits = {f.message for f in analysis.findings}
-    for finding in analysis.findings:
-        print(f"  {'hard' if finding.hard else 'soft'} limit: {finding.message}")
-    for w in analysis.warnings:
-        if w not in limits:
-            print(f"  note: {w}")
+    for finding in analysis.findings:  # hard, soft, then notes
+        label = "note" if finding.note else f"{finding.severity.value} limit"
+        print(f"  {label}: {finding.message}")
     if analysis.violations:
         print(f"design limits violated: {', '.join(analysis.violations)}")
         return EXIT_LIMIT

@@ -106,11 +106,11 @@ def _segment(
                 except ValueRuleError as err:  # a wrong type: say what the law allows too
                     if "allowed:" in err.message or rule.check is None:
                         raise
-                    raise ValueRuleError(err.path, f"{err.message}; allowed: {rule.check.allowed}") from None
+                    raise ValueRuleError(err.field, f"{err.message}; allowed: {rule.check.allowed}") from None
     try:
         law = make_law(law_name, **law_params)
     except DesignError as err:
-        raise DesignError(f"{path}.{err.path}", err.message) from None
+        raise DesignError(f"{path}.{err.field}", err.message) from None
     start, end = (_boundary(f"{path}.{name}", table.get(name)) for name in _BLEND_KEYS)
     return SegmentSpec(kind=kind, span=span * DEG, lift=lift, law=law, start=start, end=end)
 

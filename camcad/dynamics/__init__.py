@@ -36,13 +36,12 @@ from camcad.dynamics.film import FilmResult, LubricationSpec, analyse_film
 from camcad.dynamics.jump import covering_arc, loss_runs, min_preload, speed_limits
 from camcad.dynamics.life import LifeSpec, LoadStressLine, RollerLife, TrackLife, roller_life, track_life
 from camcad.dynamics.model import analyse_dynamics
-from camcad.dynamics.results import CSV_HEADER, DynamicsResult
+from camcad.dynamics.results import DynamicsResult
 from camcad.dynamics.rolling import ContactMotion, contact_motion
 from camcad.dynamics.spring import Spring, coil_spring_rate, spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, TappetForces, tappet_forces, travel_sign
 
 __all__ = [
-    "CSV_HEADER",
     "STANDARD_GRAVITY",
     "CharacteristicValues",
     "ContactMotion",

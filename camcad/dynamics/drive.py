@@ -447,7 +447,7 @@ _FIRST, _ZOOM = 513, 129  # samples per piece, then per bracket
 def _law_maxima(law: Law, pieces: list[tuple[float, float]]) -> tuple[float, float, float, float]:
     """Maxima of |y′|, |y″|, |y‴| and |y′y″| over the pieces, one law evaluation per zoom for all.
 
-    Hand-written instead of a scalar optimiser: a law evaluates a whole array
+    Hand-written instead of a scalar optimizer: a law evaluates a whole array
     in the time of a few points, so every bracket of every quantity is
     sampled in one call per zoom (7 calls in all, where a bounded Brent
     search per bracket takes some 500). Each zoom resamples the interval

@@ -152,7 +152,7 @@ def carried_contact(
     CarriedContact
         Without flanks the profile carries the contact where F > 0. On a
         groove the flank offset d of the profile carries it (inner where
-        F ≥ 0, outer where F < 0): its speeds are those of ``cam.offset(φ, d)``
+        F ≥ 0, outer where F < 0): its speeds are those of ``cam.offset_curve(φ, d)``
         (in pure rolling u = w, the speed at which the contact runs over that flank).
     """
     f = np.asarray(force, dtype=float)
@@ -166,7 +166,9 @@ def carried_contact(
         return CarriedContact(load=load, curvature=curvature, motion=contact)
     inner_at, outer_at = setup.flank_offsets
     inner, outer = (
-        contact_motion(cam, phi, omega=setup.omega, profile=cam.offset(phi, d, side=side), motion=motion)
+        contact_motion(
+            cam, phi, omega=setup.omega, profile=cam.offset_curve(phi, d, side=side), motion=motion
+        )
         for d in (inner_at, outer_at)
     )
     on_outer = f < 0.0

@@ -276,7 +276,7 @@ def analyse_dynamics(
     Returns
     -------
     DynamicsResult
-        Per-sample arrays, true extremes, jump limits and warnings.
+        Per-sample arrays, true extremes, jump limits and findings (notes included).
 
     Raises
     ------
@@ -334,7 +334,7 @@ def analyse_dynamics(
         window = speed_window(max(lower.value, 0.0), upper.value)
         speeds = None if window is None else (window[0] * _RAD_S_TO_RPM, window[1] * _RAD_S_TO_RPM)
 
-    warnings = _guide_notes(phi, sampled, dyn)
+    notes = _guide_notes(phi, sampled, dyn)
     runs = loss_runs(motion.phi, sampled.force < margin)
     if not runs and force_min.value < margin:  # lost only between samples or just before/after a joint
         runs = ((force_min.phi % TWO_PI, force_min.phi % TWO_PI),)
@@ -355,7 +355,6 @@ def analyse_dynamics(
         stress_max=stress_max,
         stress_flank=stress_flank,
     )
-    warnings = [f.message for f in findings] + warnings
     torque = np.asarray(sampled.torque, dtype=float)
     readonly(phi, torque)
     return DynamicsResult(
@@ -374,8 +373,7 @@ def analyse_dynamics(
         preload_deflection=deflection,
         speed_range_rpm=speeds,
         allowable_stress=dyn.allowable_stress,
-        warnings=tuple(warnings),
-        findings=tuple(findings),
+        findings=(*findings, *notes),
         contact_force_min=force_min,
         contact_force_max=force_max,
         torque_min=torque_min,
@@ -577,9 +575,9 @@ def _reported(r: _Pointwise, *, margin: float, omega: float, preload: float) -> 
     return np.vstack((r.force, r.force, r.torque, r.torque, r.stress, need, flat, upper, lower))
 
 
-def _guide_notes(phi: FloatArray, sampled: _Pointwise, dyn: DynamicsSpec) -> list[str]:
+def _guide_notes(phi: FloatArray, sampled: _Pointwise, dyn: DynamicsSpec) -> list[Finding]:
     """Notes where the guided tappet's guide forces change side (eq. 25's friction is then approximate)."""
-    notes: list[str] = []
+    notes: list[Finding] = []
     if sampled.near is None or sampled.far is None:
         return notes
     for name, guide, f in (("N2", sampled.near, dyn.f2), ("N3", sampled.far, dyn.f3)):
@@ -590,10 +588,19 @@ def _guide_notes(phi: FloatArray, sampled: _Pointwise, dyn: DynamicsSpec) -> lis
         if flipped:
             arc = covering_arc(flipped)
             assert arc is not None
-            notes.append(
+            message = (
                 f"guide force {name} changes side {_arc_text(arc)}: Hren et al. eq. 25 "
                 "assumes the guide contacts of its Fig. 2, so the guide friction there "
                 "is approximate"
+            )
+            notes.append(
+                Finding(
+                    kind="guide force side",
+                    severity=Severity.NOTE,
+                    field="dynamics.model",
+                    message=message,
+                    angle=arc[0],
+                )
             )
     return notes
 

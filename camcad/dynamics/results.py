@@ -1,15 +1,15 @@
 """The outcome of a dynamic analysis: per-sample arrays and the summary numbers.
 
 No file I/O here: :meth:`DynamicsResult.summary` gives the ``dynamics``
-section of ``summary.json`` and :meth:`DynamicsResult.csv_rows` the rows of
-``dynamics.csv``, both for the pipeline to write.
+section of ``summary.json`` for the pipeline to write (``dynamics.csv`` is
+written from the arrays by :func:`camcad.export.tables.write_dynamics_csv`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -19,11 +19,7 @@ from camcad.dynamics.spec import DynamicsModel
 from camcad.extremes import SIDE_WORDS, Extreme
 from camcad.findings import Finding
 
-__all__ = ["CSV_HEADER", "FLANK_WORDS", "DynamicsResult"]
-
-CSV_HEADER = ("angle_deg", "contact_force_N", "torque_Nmm", "hertz_stress_MPa")
-"""Column names of ``dynamics.csv``."""
-
+__all__ = ["FLANK_WORDS", "DynamicsResult"]
 
 FLANK_WORDS = ("inner", "outer")
 """A groove's flanks: the inner drives where the contact force is positive, the outer where negative."""
@@ -84,11 +80,9 @@ class DynamicsResult:
         (high may be ``inf``); ``None`` if no speed does.
     allowable_stress
         ``[dynamics].allowable_stress`` [MPa] or ``None``.
-    warnings
-        Every message for the report, one sentence each: the findings' and
-        notes on the model's validity (guide forces changing side).
     findings
-        The broken limits (jump, contact stress) as typed findings.
+        The broken limits (jump, contact stress) and the notes on the
+        model's validity (guide forces changing side) as typed findings.
     contact_force_min, contact_force_max, torque_min, torque_max, hertz_stress_max
         True extremes over the turn (one-sided limits at joints included), when
         the analysis had the exact cam; else ``None`` and the summary falls back
@@ -110,7 +104,6 @@ class DynamicsResult:
     preload_deflection: float | None = None
     speed_range_rpm: tuple[float, float] | None = None
     allowable_stress: float | None = None
-    warnings: tuple[str, ...] = ()
     findings: tuple[Finding, ...] = ()
     contact_force_min: Extreme | None = None
     contact_force_max: Extreme | None = None
@@ -123,8 +116,6 @@ class DynamicsResult:
     # a groove's inner and outer flank: the largest load [N] and Hertz stress [MPa] where each drives
     flank_force_max: tuple[Extreme, Extreme] | None = None
     flank_stress_max: tuple[Extreme, Extreme] | None = None
-
-    csv_header: ClassVar[tuple[str, ...]] = CSV_HEADER
 
     @property
     def jump(self) -> bool:
@@ -149,8 +140,8 @@ class DynamicsResult:
             ``None``); then ``jump`` (bool), ``jump_range_deg`` ([start, end]
             in degrees, start > end through 0°, or ``None``),
             ``min_preload_N``, ``speed_range_rpm`` ([low, high] or ``None``;
-            both left out for positive drive, where no jump check applies)
-            and ``warnings`` (list of str). A groove adds
+            both left out for positive drive, where no jump check applies).
+            A groove adds
             ``hertz_stress_max_flank`` (``"inner"`` or ``"outer"``, the flank
             that carries the peak) and ``flanks``: for each flank the largest
             load it carries where it drives (``contact_force_max_N``) and its
@@ -179,7 +170,6 @@ class DynamicsResult:
                 ("min_preload_N" if self.preload_unit == "N" else "min_preload_N_mm"): self.min_preload,
                 "speed_range_rpm": None if self.speed_range_rpm is None else list(self.speed_range_rpm),
             }
-        out["warnings"] = list(self.warnings)
         if self.flank_force_max is not None and self.flank_stress_max is not None:
             out["hertz_stress_max_flank"] = self.hertz_stress_flank
             out["flanks"] = {
@@ -202,29 +192,3 @@ class DynamicsResult:
         if self.flank_stress_max is None:
             return None
         return FLANK_WORDS[0 if self.flank_stress_max[0].value >= self.flank_stress_max[1].value else 1]
-
-    def table(self) -> FloatArray:
-        """(n, 4) array of the ``dynamics.csv`` columns (see ``csv_header``).
-
-        Returns
-        -------
-        FloatArray
-            Columns: angle [deg], contact force [N], torque [N·mm], Hertz stress [MPa].
-        """
-        out = np.column_stack((np.degrees(self.phi), self.contact_force, self.torque, self.hertz_stress))
-        out.flags.writeable = False
-        return out
-
-    def csv_rows(self) -> list[tuple[str, ...]]:
-        """Rows of ``dynamics.csv``, the header first, numbers in a fixed format.
-
-        Returns
-        -------
-        list[tuple[str, ...]]
-            ``("angle_deg", ...)`` then one row per sample, every number with
-            6 decimals, ready for :func:`csv.writer`.
-        """
-        rows: list[tuple[str, ...]] = [CSV_HEADER]
-        for angle, force, torque, stress in self.table():
-            rows.append((f"{angle:.6f}", f"{force:.6f}", f"{torque:.6f}", f"{stress:.6f}"))
-        return rows

@@ -98,12 +98,12 @@ def contact_motion(
     tangent = np.asarray(prof.tangent, dtype=float)
     arc = np.hypot(d1[:, 0], d1[:, 1])
     w = np.einsum("ij,ij->i", d1, tangent) * omega  # signed along t (≥ 0 but at a cusp)
-    if cam.kinematics.rolls:
+    if cam.follower.rolls:
         slip = np.zeros_like(p)
     else:
         contact = cam.machine_points(p, np.asarray(prof.point, dtype=float))  # machine frame
         t_machine = cam.to_machine(p, tangent)
-        guide = cam.kinematics.guide
+        guide = cam.follower.guide
         direction = guide.driven(contact)
         m = cam.motion(p) if motion is None else motion
         rate = np.asarray(m.v, dtype=float) * omega  # ṡ [mm/s] or ψ̇ [deg/s]
@@ -122,5 +122,5 @@ def contact_motion(
         slip=slip,
         sliding_speed=sliding,
         entraining_speed=u,
-        rolling=cam.kinematics.rolls,
+        rolling=cam.follower.rolls,
     )

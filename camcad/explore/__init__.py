@@ -1,4 +1,4 @@
-"""Design exploration: constrained optimisation, sweeps of the design space and Pareto fronts.
+"""Design exploration: constrained optimization, sweeps of the design space and Pareto fronts.
 
 It sits above :mod:`camcad.pipeline` (each design is analysed as ``camcad
 check`` does) and below :mod:`camcad.cli` (``camcad optimize``, ``camcad

@@ -311,7 +311,7 @@ def inspect_measured(
     try:
         ins = inspect_points(cam, measured.points, band=band)
     except DesignError as err:
-        if err.path != "measured":
+        if err.field != "measured":
             raise
         raise DesignError(where, _relined(err.message, measured.lines)) from None
     act = actual_motion(cam, ins)

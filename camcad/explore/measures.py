@@ -260,9 +260,9 @@ def measure_values(analysis: Analysis, summary: Mapping[str, Any] | None = None)
 
 
 def _flat(prefix: str, section: Mapping[str, Any], out: dict[str, Any]) -> None:
-    """Scalars of a summary section as ``prefix.key``; lists as JSON text; warnings and joints left out."""
+    """Scalars of a summary section as ``prefix.key``; lists as JSON text; joints left out."""
     for key, value in section.items():
-        if key in ("warnings", "joints"):
+        if key == "joints":
             continue
         name = f"{prefix}.{key}"
         if isinstance(value, Mapping):
@@ -287,7 +287,7 @@ def analysis_row(analysis: Analysis, limits: Sequence[Limit]) -> dict[str, Any]:
     from ``summary.json``.
     """
     summary = analysis.summary()
-    findings = analysis.findings
+    findings = [f for f in analysis.findings if not f.note]  # the broken limits; a note breaks none
     row: dict[str, Any] = {
         "status": "limit" if findings else "ok",
         "feasible": False,

@@ -1,4 +1,4 @@
-"""Constrained optimisation of a design over chosen design-file keys, and two-objective Pareto fronts.
+"""Constrained optimization of a design over chosen design-file keys, and two-objective Pareto fronts.
 
 The problem (after Quang & Hung 2015, whose design problem is to make the cam
 as small as possible and keep the contact stress low by choosing the base
@@ -89,7 +89,7 @@ MAX_STARTS = 1000
 MAX_FRONT_POINTS = 200
 """Most points of a two-objective front (``--points``)."""
 MAX_COMBINATIONS = 1000
-"""Most combinations of the discrete choices (``--vary name=a,b,…``), each a full optimisation."""
+"""Most combinations of the discrete choices (``--vary name=a,b,…``), each a full optimization."""
 _INVALID = -10.0  # the relative margin of every constraint at a design that cannot be analysed
 _FD_STEP = 1e-7  # finite-difference step on the variables scaled to [0, 1]
 _EDGE_STEP = 1e-5  # scaled step that probes whether an optimum sits on the edge of the valid designs
@@ -97,7 +97,7 @@ _EDGE_STEP = 1e-5  # scaled step that probes whether an optimum sits on the edge
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Problem:
-    """What to optimise: the base design's mapping, variables, one or two objectives and the limits."""
+    """What to optimize: the base design's mapping, variables, one or two objectives and the limits."""
 
     data: Mapping[str, Any]
     source: str = ""
@@ -123,7 +123,7 @@ class ConstraintState:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Candidate:
-    """A design the optimiser ended at: its values, objectives, constraints and the design mapping."""
+    """A design the optimizer ended at: its values, objectives, constraints and the design mapping."""
 
     values: dict[str, Any]
     objectives: dict[str, float | None]
@@ -194,7 +194,7 @@ _OWN_KEYS: dict[tuple[str, str], tuple[str, str]] = {
 
 
 def design_limits(data: Mapping[str, Any], limits: Sequence[Limit], *, source: str = "") -> tuple[Limit, ...]:
-    """The limits an optimisation keeps: the design's own, replaced or joined by ``limits``.
+    """The limits an optimization keeps: the design's own, replaced or joined by ``limits``.
 
     The design's own are ``pressure_angle <= cam.max_pressure_angle``,
     ``contact_stress <= dynamics.allowable_stress`` when it is given, and
@@ -377,7 +377,7 @@ class _Evaluator:
         )
         # every part's further curves (a groove's flanks) loop where their radius reaches 0 (hard)
         rho_margin = min([rho_margin, *(c.radius_margin for r in analysis.parts for c in r.part.checks)])
-        findings = tuple(f.message for f in analysis.findings)
+        findings = tuple(f.message for f in analysis.findings if not f.note)
         return _Point(measures, pieces, float(rho_margin), max(design.cam.base_radius, 1.0), findings, True)
 
 
@@ -640,7 +640,7 @@ def optimize(problem: Problem, *, progress: Callable[[str], None] | None = None)
         raise UsageError(
             "--vary",
             f"{count} combinations of the choices; allowed: at most {MAX_COMBINATIONS} "
-            "(each is a full optimisation: list fewer choices, or make a variable a range low:high)",
+            "(each is a full optimization: list fewer choices, or make a variable a range low:high)",
         )
     combos = list(itertools.product(*(v.choices or () for v in discrete)))
     tried: list[Candidate] = []

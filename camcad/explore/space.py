@@ -11,12 +11,12 @@ rpm, N, N/mm, MPa).
 A variant is the design's TOML mapping with the variables' values written in,
 validated again by :func:`camcad.design.parse_design`: every variant obeys
 the same rules as a design file, its errors name the field, and the result of
-an optimisation can be written back as a design file
+an optimization can be written back as a design file
 (:func:`camcad.design.toml_text.toml_text`).
 
 Value syntax (``--grid`` and ``--vary``): ``name=start:stop:count`` (a grid of
 ``count`` equally spaced values, both ends included), ``name=low:high`` (a
-continuous range: optimisation, Latin-hypercube sampling) or
+continuous range: optimization, Latin-hypercube sampling) or
 ``name=a,b,c`` (discrete choices, tried one by one).
 """
 
@@ -206,7 +206,7 @@ def parse_variable(
         The option, named by every error (``--grid``, ``--vary``).
     counted
         True: a range must carry a count (a grid sweep); False: a range is
-        continuous and a count is refused (optimisation, Latin-hypercube
+        continuous and a count is refused (optimization, Latin-hypercube
         sampling).
     source
         The design file's name, for the validated designs.
@@ -290,7 +290,7 @@ def _check_value(
         # a check across fields (an offset beyond r_b + r_f at the file's r_b) may pass at other grid
         # values of the other variables, so it is the design's, found row by row
         own = err.message.startswith((repr(value), "unknown key", "expected", "applies to"))
-        if err.path in places and (own or variable.path.endswith(".law")):
+        if err.field in places and (own or variable.path.endswith(".law")):
             raise UsageError(flag, f"{text!r}: {err}") from None
 
 

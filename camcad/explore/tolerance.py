@@ -79,7 +79,7 @@ Progress = Callable[[int, int], None]
 
 def _unit(cam: Cam) -> str:
     """The lift's unit: ``mm`` on a slide, ``deg`` of swing on an arm."""
-    return cam.follower.kind.lift_unit
+    return cam.follower_spec.kind.lift_unit
 
 
 def _column(key: str) -> str:

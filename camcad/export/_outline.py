@@ -318,7 +318,7 @@ def arc_outline(curve: CurveFn, breakpoints: Sequence[float], tolerance: float) 
     Parameters
     ----------
     curve
-        The exact curve with two φ-derivatives (e.g. ``cam.offset(φ, 0)``, the
+        The exact curve with two φ-derivatives (e.g. ``cam.offset_curve(φ, 0)``, the
         profile); its tangent must be continuous (a cam without velocity jumps).
     breakpoints
         Angles [rad] every fit passes through with the curve's tangent

@@ -158,7 +158,7 @@ LAYERS: dict[str, tuple[int, str]] = {
 class DxfCurve:
     """One certified closed curve of a drawing: its layer, its fit, and the exact curve it stands for.
 
-    The exact curve is ``cam.offset(φ, offset)``: the profile for ``offset = 0``,
+    The exact curve is ``cam.offset_curve(φ, offset)``: the profile for ``offset = 0``,
     a groove's flank for the offsets of :func:`camcad.geometry.groove.flank_offsets`.
     """
 
@@ -418,13 +418,13 @@ def dxf_text(text: str) -> str:
 
 def _annotation_lines(cam: Cam, plate: Plate, curves: Sequence[DxfCurve]) -> list[str]:
     """Plain-ASCII lines of the annotation block."""
-    follower, bore = cam.follower, plate.bore
+    follower, bore = cam.follower_spec, plate.bore
     sizes = f"base radius {cam.base_radius:.3f} mm, thickness {plate.thickness:.3f} mm"
     if bore is not None:
         sizes += f", bore dia {2.0 * bore.radius:.3f} mm"
         if bore.has_keyway:
             sizes += f", keyway {bore.keyway_width:.3f} x {bore.keyway_depth:.3f} mm"
-    who = cam.kinematics.describe()
+    who = cam.follower.describe()
     if follower.kind.face and follower.face_width is not None:
         who += f", face width {follower.face_width:.3f} mm"
     who = f"follower {follower.kind.word}: {who}, rotation {cam.rotation.value}"
@@ -572,7 +572,7 @@ def profile_arcs_document(
 ) -> Drawing:
     """Build the ``profile_arcs.dxf`` document: the profile as tangent arcs, the bore as ARC/LINE/CIRCLE.
 
-    The arcs are biarcs through the exact profile ``cam.offset(φ, 0)``
+    The arcs are biarcs through the exact profile ``cam.offset_curve(φ, 0)``
     within the fit tolerance ``fit.tolerance``, measured two-way
     (:func:`~camcad.export._outline.arc_outline`); consecutive arcs share end
     points and tangents. ``options`` is accepted for a uniform signature.
@@ -583,7 +583,7 @@ def profile_arcs_document(
     for curve in _curves(fit, curves):
 
         def exact(phi: np.ndarray, d: float = curve.offset) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-            o = cam.offset(phi, d)
+            o = cam.offset_curve(phi, d)
             return o.point, o.d1, o.d2
 
         tol = curve.fit.tolerance

@@ -393,7 +393,7 @@ def build_groove_solid(
     exact = None
     if cam is not None and offsets is not None:
         breaks = list(cam.program.pieces)
-        exact_areas = [abs(analytic_area(lambda p, d=d: cam.offset(p, d), breaks)[0]) for d in offsets]
+        exact_areas = [abs(analytic_area(lambda p, d=d: cam.offset_curve(p, d), breaks)[0]) for d in offsets]
         exact = exact_areas[1] - exact_areas[0]
         fit_bound = sum(f.max_error * length for f, length in zip(flanks, lengths, strict=True))
         if abs(groove_spline - exact) > fit_bound + AREA_ROUNDOFF * exact_areas[1]:

@@ -109,7 +109,7 @@ def _ray_angle(points: FloatArray, sign: float) -> FloatArray:
 
 def _curve(cam: Cam, phi: FloatArray, distance: float) -> FloatArray:
     """(n, 2) points of the profile (distance 0) or of its offset by ``distance`` [mm]."""
-    out: FloatArray = (cam.profile(phi) if distance == 0.0 else cam.offset(phi, distance)).point
+    out: FloatArray = (cam.profile(phi) if distance == 0.0 else cam.offset_curve(phi, distance)).point
     return out
 
 
@@ -119,7 +119,7 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation, distance: f
     Parameters
     ----------
     cam
-        The exact cam; ``cam.offset(phi, distance)`` gives the point at cam
+        The exact cam; ``cam.offset_curve(phi, distance)`` gives the point at cam
         angle φ (the contact point for ``distance = 0``, the centre of a
         wheel of radius ``distance`` rolling on the profile otherwise).
     theta
@@ -158,7 +158,8 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation, distance: f
         raise NotStarShapedError(
             f"cam.base_radius: the {curve} is not star-shaped about the cam axis near cam angle "
             f"{math.degrees(bad):.2f}°: a ray meets it twice, so {table} has no polar radius; "
-            "use a larger cam.base_radius or a smaller follower.offset"
+            "use a larger cam.base_radius or a smaller follower.offset",
+            field="cam.base_radius",
         )
     start = angle[0]
     target = start + np.mod(theta - start, 2.0 * math.pi)  # in [θ_C(0), θ_C(0) + 2π)
@@ -280,6 +281,7 @@ def polar_table_text(cam: Cam, options: TablesSpec, *, name: str = "") -> str:
             f"{math.degrees(err.phi_range[0]):.1f}°); allowed: wheel_radius ≤ {err.max_tool_radius:.4f} mm",
             phi_range=err.phi_range,
             max_tool_radius=err.max_tool_radius,
+            field="tables.wheel_radius",
         ) from None
     step = options.step if options.polar_step is None else options.polar_step
     angle = table_angles(step)

@@ -497,6 +497,10 @@ def analyse_fea(
                 ),
             )
         )
+    # an angle with no load case is worth knowing but breaks no limit
+    findings += [
+        Finding(kind="FE load case", severity=Severity.NOTE, field="fea.angles", message=t) for t in skipped
+    ]
     return FeaResult(
         nodes=model.nodes,
         cells=model.cells,

@@ -121,11 +121,11 @@ class FeaResult:
     cases
         One solution per load case.
     skipped
-        Notes on angles that could not be loaded (no contact, conforming contact).
+        Why an angle could not be loaded (no contact, conforming contact); each is also a NOTE finding.
     allowable_stress
         ``[fea] allowable_stress`` [MPa] or None.
     findings
-        The broken limit (peak von Mises over the allowable), if any.
+        The broken limit (peak von Mises over the allowable), if any, then a note per skipped angle.
     """
 
     nodes: FloatArray
@@ -147,11 +147,6 @@ class FeaResult:
     def peak(self) -> StressCase | None:
         """The case with the largest von Mises stress (None without cases)."""
         return max(self.cases, key=lambda c: c.peak.value, default=None)
-
-    @property
-    def warnings(self) -> tuple[str, ...]:
-        """Every message for the report: the findings' and the skipped angles."""
-        return tuple(f.message for f in self.findings) + self.skipped
 
     def summary(self) -> dict[str, Any]:
         """The ``fea`` section of ``summary.json`` (plain Python values, angles in degrees)."""

@@ -165,11 +165,6 @@ class ElasticPlate:
 
         self._mapping.invF = inverse
 
-    @property
-    def dofs(self) -> int:
-        """Number of unknowns (two per P2 node)."""
-        return int(self._stiffness.shape[0])
-
     def area(self) -> float:
         """The meshed area [mm²], on the curved (isoparametric) elements."""
         from skfem import Functional, asm

@@ -3,8 +3,8 @@
 The count search stops at the smaller of two limits: the control-point
 budget (the caller's ``max_control_points``, or the automatic one) and the
 room the samples leave for knots. The error names the binding one in the
-caller's own words (a design field path such as ``fit.max_control_points``),
-with its value, the control points reached, the best certified error and a
+caller's own words (a design field path such as ``fit.max_control_points``,
+also its ``field``), with its value, the control points reached, the best certified error and a
 way out.
 """
 
@@ -89,24 +89,28 @@ def limit_error(
             f"{names.tolerance}: {tolerance:.3g} mm is out of reach: {n_samples} samples leave room for "
             f"at most {reached} control points ({at_best}); relax {names.tolerance}"
         )
-        return SamplesTooFewError(message, best_error=best_error, control_point_count=cps)
+        return SamplesTooFewError(
+            message, best_error=best_error, control_point_count=cps, field=names.tolerance
+        )
     if samples_bind:
         message = (
             f"{names.samples}: {n_samples} samples leave room for at most {reached} control points, too "
             f"few for {tol} ({at_best}); sample more finely ({names.samples}) or relax {names.tolerance}"
         )
-        return SamplesTooFewError(message, best_error=best_error, control_point_count=cps)
+        return SamplesTooFewError(
+            message, best_error=best_error, control_point_count=cps, field=names.samples or ""
+        )
     if automatic_budget:
         message = (
             f"{names.tolerance}: {tolerance:.3g} mm is out of reach: the search reached {reached} control "
             f"points (the automatic limit, {max_control_points}), {at_best}; relax {names.tolerance} "
             f"(or set {names.max_control_points} higher if memory allows)"
         )
-        return FitError(message, best_error=best_error, control_point_count=cps)
+        return FitError(message, best_error=best_error, control_point_count=cps, field=names.tolerance)
     need = "" if needed is None else f" (about {needed} needed)"
     message = (
         f"{names.max_control_points}: {max_control_points} control points are too few for {tol}: the "
         f"search reached {reached}, {at_best}; raise {names.max_control_points}{need}, leave it out "
         f"(automatic) or relax {names.tolerance}"
     )
-    return FitError(message, best_error=best_error, control_point_count=cps)
+    return FitError(message, best_error=best_error, control_point_count=cps, field=names.max_control_points)

@@ -25,7 +25,7 @@ def fit_cam_profile(
     step: float | None = None,
     offset: float = 0.0,
 ) -> ProfileFit:
-    """Certified B-spline of ``cam.profile`` (or of its offset ``cam.offset(φ, offset)``) over one turn.
+    """Certified B-spline of ``cam.profile`` (or of its offset ``cam.offset_curve(φ, offset)``) over one turn.
 
     A disc cam's closed profile gives a periodic B-spline; a linear cam's
     open edge (``cam.closed`` false) a clamped one from φ = 0 to 2π.
@@ -58,7 +58,7 @@ def fit_cam_profile(
         Fit the profile offset outward by this distance [mm] instead of the
         profile itself (a groove's flanks,
         :func:`camcad.geometry.groove.groove_flanks`); the certificate is then
-        against ``cam.offset(φ, offset)``.
+        against ``cam.offset_curve(φ, offset)``.
 
     Raises
     ------
@@ -82,8 +82,8 @@ def fit_cam_profile(
         try:
             return fit(
                 phi,
-                np.asarray(cam.offset(phi, offset).point),
-                exact=lambda p: cam.offset(p, offset).point,
+                np.asarray(cam.offset_curve(phi, offset).point),
+                exact=lambda p: cam.offset_curve(p, offset).point,
                 breakpoints=[(b.phi, b.continuity) for b in cam.program.breakpoints],
                 tolerance=tolerance,
                 max_control_points=max_control_points,

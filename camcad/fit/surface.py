@@ -368,6 +368,7 @@ def _fit_wall(
         f"{fit.max_spans} knot spans (best {best[1].max_error:.4g} mm); loosen the tolerance",
         best_error=best[1].max_error,
         control_point_count=best[0].distinct_u * best[0].control_points.shape[1],
+        field="fit.tolerance",
     )
 
 

@@ -110,8 +110,9 @@ class Cam:
         The motion program s(φ).
     base_radius
         r_b [mm]: the smallest radius of the cam profile.
-    follower
-        The design's follower table (kind, roller radius r_f [mm], offset e [mm]).
+    follower_spec
+        The design's ``[follower]`` table (kind, roller radius r_f [mm],
+        offset e [mm]); the follower it builds is :attr:`follower`.
     rotation
         ``CCW`` (default) or ``CW``.
     stroke_length
@@ -135,7 +136,7 @@ class Cam:
 
     program: MotionProgram
     base_radius: float
-    follower: FollowerSpec
+    follower_spec: FollowerSpec
     rotation: Rotation = Rotation.CCW
     sample_step: float = math.radians(0.1)
     conjugate: ConjugateSpec | None = None  # set: this is the pair's second plate, driving the tied roller
@@ -150,7 +151,7 @@ class Cam:
         return cls(
             program=MotionProgram.from_segments(design.motion),
             base_radius=design.cam.base_radius,
-            follower=design.follower,
+            follower_spec=design.follower,
             rotation=design.cam.rotation,
             sample_step=design.cam.sample_step,
         )
@@ -158,18 +159,18 @@ class Cam:
     # -- basic quantities -------------------------------------------------
 
     @property
-    def kinematics(self) -> Follower:
+    def follower(self) -> Follower:
         """The follower module at this cam's base radius (the tied roller on a pair's second plate).
 
         Built once per cam: every evaluation of the cam's curves asks for it.
         """
-        if "kinematics" not in self._memo:
-            self._memo["kinematics"] = self._follower()
-        out: Follower = self._memo["kinematics"]
+        if "follower" not in self._memo:
+            self._memo["follower"] = self._follower()
+        out: Follower = self._memo["follower"]
         return out
 
     def _follower(self) -> Follower:
-        first = follower_from_spec(self.follower, self.base_radius)
+        first = follower_from_spec(self.follower_spec, self.base_radius)
         if self.conjugate is None:
             return first
         top_phi = max((bp.phi for bp in self.program.breakpoints), key=lambda p: float(self.motion(p).s[0]))
@@ -201,17 +202,17 @@ class Cam:
         undercut makes it loop; a flat face's envelope is the profile itself,
         and undercut makes a cusp.
         """
-        return self.kinematics.roller_radius > 0.0
+        return self.follower.roller_radius > 0.0
 
     @property
     def roller_radius(self) -> float:
         """The contact circle's radius [mm] (a roller's r_f, a curved face's radius); 0 for a flat face."""
-        return self.kinematics.roller_radius
+        return self.follower.roller_radius
 
     @property
     def eccentricity(self) -> float:
         """Follower eccentricity e [mm] (the design file's ``offset``): its axis is the line x = e."""
-        return self.follower.eccentricity
+        return self.follower_spec.eccentricity
 
     @property
     def closed(self) -> bool:
@@ -340,7 +341,7 @@ class Cam:
 
     def _element(self, phi: ArrayLike, side: Side) -> tuple[Motion, PointElement | LineElement]:
         m = self.motion(phi, side=side)
-        return m, self.kinematics.element(m)
+        return m, self.follower.element(m)
 
     def pitch(self, phi: ArrayLike, *, side: Side = "right") -> CurveSample:
         """The pitch curve at cam angles φ [rad].
@@ -350,7 +351,7 @@ class Cam:
         follower axis). ``side`` picks the one-sided limit at joints.
         """
         m = self.motion(phi, side=side)
-        return self._point_envelope(m, self.kinematics.trace(m))[0]
+        return self._point_envelope(m, self.follower.trace(m))[0]
 
     def _base_curve(self, phi: ArrayLike, side: Side) -> tuple[CurveSample, FloatArray, float]:
         """The curve offsets are taken from, its dρ/dφ, and the profile's distance from it [mm].
@@ -365,7 +366,7 @@ class Cam:
         base, drho = self._line_envelope(m, element)
         return base, drho, 0.0
 
-    def offset(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
+    def offset_curve(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
         """The profile offset outward by ``distance`` [mm] at cam angles φ [rad].
 
         ``distance = r`` is the centre path of a milling tool (or a roller) of
@@ -377,8 +378,8 @@ class Cam:
         return offset_curve(base, drho, distance + profile_at)
 
     def profile(self, phi: ArrayLike, *, side: Side = "right") -> CurveSample:
-        """The cam profile (contact point C) at cam angles φ [rad]; ``side`` as in :meth:`offset`."""
-        return self.offset(phi, 0.0, side=side)
+        """The cam profile (contact point C) at cam angles φ [rad]; ``side`` as in :meth:`offset_curve`."""
+        return self.offset_curve(phi, 0.0, side=side)
 
     def _driven_point(self, phi: ArrayLike, side: Side) -> tuple[CurveSample, FloatArray]:
         """The profile, and the follower point that is driven (roller centre or contact), machine frame."""
@@ -415,7 +416,7 @@ class Cam:
             base, drho = self._line_envelope(m, element)
             profile = base
             driven = profile.point
-        guide = self.kinematics.guide
+        guide = self.follower.guide
         turned = self.frame_angle(m.phi)
         driven_machine = self.machine_points(m.phi, driven)
         alpha = pressure_angle(turned, profile.normal, driven_machine, guide, self.sigma)
@@ -425,7 +426,7 @@ class Cam:
             arm = driven_machine - np.asarray(guide.pivot)
             lever = np.hypot(arm[:, 0], arm[:, 1])
             readonly(lever)
-        position = self.kinematics.contact_position(contact, m)
+        position = self.follower.contact_position(contact, m)
         readonly(position)
         return CamState(
             lever=lever,
@@ -461,7 +462,7 @@ class Cam:
         """
         profile, driven = self._driven_point(phi, side)
         turned = self.frame_angle(profile.phi)
-        return pressure_angle(turned, profile.normal, driven, self.kinematics.guide, self.sigma)
+        return pressure_angle(turned, profile.normal, driven, self.follower.guide, self.sigma)
 
     def contact_offset(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
         """Where the contact sits on the follower [mm] (:meth:`Follower.contact_position`).
@@ -475,7 +476,7 @@ class Cam:
         m = self.motion(phi, side=side)
         profile = self.profile(phi, side=side)
         contact = self.machine_points(profile.phi, profile.point)
-        out = self.kinematics.contact_position(contact, m)
+        out = self.follower.contact_position(contact, m)
         readonly(out)
         return out
 

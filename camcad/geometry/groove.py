@@ -4,7 +4,7 @@ The groove's centre line is the pitch curve (the roller centre's path); its
 flanks are the pitch curve offset by ∓(r_f + c/2), c the radial clearance, so
 the groove is 2r_f + c wide everywhere (Rothbart 2004, §8.2; Norton 2009,
 §8.11). Both flanks are exact offsets of the same base curve
-(:meth:`camcad.geometry.cam.Cam.offset`), with exact normals and curvature.
+(:meth:`camcad.geometry.cam.Cam.offset_curve`), with exact normals and curvature.
 
 Limits, all at true extremes (one-sided at joints included):
 
@@ -45,11 +45,11 @@ def groove_flanks(
     flanks are the pitch curve offset by −(r_f + c/2) and +(r_f + c/2).
     """
     inner_at, outer_at = flank_offsets(cam, clearance)
-    return cam.offset(phi, inner_at, side=side), cam.offset(phi, outer_at, side=side)
+    return cam.offset_curve(phi, inner_at, side=side), cam.offset_curve(phi, outer_at, side=side)
 
 
 def flank_offsets(cam: Cam, clearance: float) -> tuple[float, float]:
-    """The inner and outer flank as offsets of the profile [mm] (``cam.offset(φ, d)``).
+    """The inner and outer flank as offsets of the profile [mm] (``cam.offset_curve(φ, d)``).
 
     The profile is the pitch curve offset by −r_f, so the inner flank, at
     −(r_f + c/2) from the pitch curve, is the profile offset by −c/2, and the

@@ -73,16 +73,6 @@ class GeometryAnalysis:
     # smallest concave profile radius [mm] (positive), a loop or cusp not counted; None if none
     concave_radius_min: Extreme | None
 
-    @property
-    def warnings(self) -> tuple[str, ...]:
-        """The messages of the soft findings (pressure angle)."""
-        return tuple(f.message for f in self.findings if not f.hard)
-
-    @property
-    def profile_radius(self) -> FloatArray:
-        """(n,) polar radius of the contact point [mm]."""
-        return np.hypot(self.profile.point[:, 0], self.profile.point[:, 1])
-
     def summary(self) -> dict[str, Any]:
         """The ``geometry`` section of summary.json (angles in degrees, lengths mm).
 
@@ -96,7 +86,6 @@ class GeometryAnalysis:
         _put(out, "curvature_radius_min", self.curvature_radius_min, unit="mm")
         _put(out, "concave_radius_min", self.concave_radius_min, unit="mm")
         out["undercut"] = self.undercut is not None
-        out["warnings"] = list(self.warnings)
         if self.face_width_min is not None:
             out["face_width_min_mm"] = self.face_width_min
         return out
@@ -306,8 +295,8 @@ def analyse_geometry(
     if alpha_max.value > max_pressure_angle:
         findings.append(_pressure_finding(phi, alpha, alpha_max, max_pressure_angle))
     face_min = None
-    if cam.follower.kind.face:
-        check = _face_check if cam.kinematics.guide.pivot is None else _arm_face_check
+    if cam.follower_spec.kind.face:
+        check = _face_check if cam.follower.guide.pivot is None else _arm_face_check
         face_min, found = check(reach_min, reach_max, face_width, face_margin)
         findings += found
 
@@ -371,7 +360,7 @@ def _pivot_clearance(cam: Cam, radius_max: Extreme) -> list[Finding]:
     swept disc. Allowed: d > R_max, a strict bound with no hub size added
     (the design states none).
     """
-    pivot = cam.kinematics.guide.pivot
+    pivot = cam.follower.guide.pivot
     if pivot is None:
         return []
     if not cam.closed:
@@ -437,7 +426,7 @@ def conjugate_overlap(partner: Cam) -> tuple[str, str] | None:
     2l·sin(θ/2) (the chord of the arm's circle of radius l). Seen along the
     shaft, the rollers overlap when that distance is below r_f + r_f2.
     """
-    tied = partner.kinematics
+    tied = partner.follower
     conj = partner.conjugate
     if conj is None or not isinstance(tied, TiedRoller):
         return None
@@ -494,7 +483,7 @@ def _velocity_jumps(cam: Cam) -> list[Finding]:
     rests, typically).
     """
     out = []
-    unit = cam.follower.kind.lift_unit  # mm on a slide, degrees of swing on an arm
+    unit = cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     shown = "°" if unit == "deg" else unit
     for joint in cam.program.joints():
         if joint.continuity > 0:
@@ -541,7 +530,7 @@ def _reversals(cam: Cam) -> list[Finding]:
     """
     out = []
     program = cam.program
-    unit = cam.follower.kind.lift_unit
+    unit = cam.follower_spec.kind.lift_unit
     shown = "°" if unit == "deg" else unit
     for k, (seg, start) in enumerate(zip(program.segments, program.starts, strict=True)):
         if seg.kind.value not in ("rise", "return") or seg.lift <= 0.0:
@@ -622,7 +611,7 @@ def _overshoot(
     way = "forwards" if seg.kind.value == "return" else "backwards"
     where = "start" if head else "end"
     first_deg, last_deg = sorted((math.degrees(edge), math.degrees(phi)))
-    unit = cam.follower.kind.lift_unit
+    unit = cam.follower_spec.kind.lift_unit
     return Finding(
         kind="motion reversal",
         severity=Severity.SOFT,
@@ -648,15 +637,15 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
         message = (
             f"linear.stroke_length: undercut at {format_ranges(list(uc.ranges))}: the pitch line's convex "
             f"radius of curvature falls to {uc.worst:.3f} mm {uc.where()}, below the "
-            f"{cam.kinematics.words.radius} {cam.roller_radius:g} mm, so the edge loops; lengthen the "
-            f"stroke (now {cam.stroke_length:g} mm), {cam.kinematics.words.smaller} or use a gentler law"
+            f"{cam.follower.words.radius} {cam.roller_radius:g} mm, so the edge loops; lengthen the "
+            f"stroke (now {cam.stroke_length:g} mm), {cam.follower.words.smaller} or use a gentler law"
         )
         return UndercutError(message, phi_range=uc.ranges[0], worst=uc.worst, suggested_base_radius=None)
     sized = min_base_radius(cam, min_curvature_radius=min_curvature_radius)
     suggestion = math.ceil(sized.base_radius / _SUGGEST_ROUND_MM) * _SUGGEST_ROUND_MM
     where = format_ranges(list(uc.ranges))
     if cam.has_pitch_curve:
-        words = cam.kinematics.words
+        words = cam.follower.words
         what = (
             f"undercut at {where}: the pitch curve's convex radius of curvature falls to "
             f"{uc.worst:.3f} mm {uc.where()}, below the {words.radius} "
@@ -666,7 +655,7 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
     else:
         what = (
             f"cusp at {where}: the profile radius of curvature "
-            f"{'r_b + s + a ' if cam.kinematics.guide.pivot is None else ''}falls to "
+            f"{'r_b + s + a ' if cam.follower.guide.pivot is None else ''}falls to "
             f"{uc.worst:.3f} mm {uc.where()}"
         )
         way_out = "or use a gentler motion law"
@@ -679,4 +668,5 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
         phi_range=uc.ranges[0],
         worst=uc.worst,
         suggested_base_radius=suggestion,
+        field="cam.base_radius",
     )

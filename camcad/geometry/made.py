@@ -115,7 +115,7 @@ def made_curve(cam: Cam, u: FloatArray, w: FloatArray, form: FormError | None) -
     ``w`` (m,) [mm] per point; for a roller, w = −r_f gives the profile itself.
     """
     m = cam.motion(u)
-    element = cam.kinematics.element(m)
+    element = cam.follower.element(m)
     if isinstance(element, PointElement):
         base, drho = point_envelope(m.phi, element, cam.sigma)
     else:

@@ -47,7 +47,6 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -129,33 +128,6 @@ class Mount:
         """The program's lift unit per unit of q: 1 (mm) on a slide, 180/π (degrees) on an arm."""
         return 1.0 if self.axis is not None else 180.0 / math.pi
 
-    def perturbed(self, deltas: Mapping[Tol, float]) -> Mount:
-        """The mount moved by ``deltas`` (cam-side errors FORM and PHASE leave it as it is)."""
-        ox, oy = self.origin
-        if self.axis is not None:
-            ax, ay = self.axis
-            e = deltas.get(Tol.ECCENTRICITY, 0.0)
-            c = deltas.get(Tol.CENTRE_DISTANCE, 0.0)
-            return replace(
-                self,
-                origin=(ox + e + c * ax, oy + c * ay),
-                roller_radius=self.roller_radius + deltas.get(Tol.ROLLER_RADIUS, 0.0),
-            )
-        assert self.pivot is not None
-        px, py = self.pivot
-        d = math.hypot(px, py)
-        c = deltas.get(Tol.CENTRE_DISTANCE, 0.0)
-        return replace(
-            self,
-            pivot=(
-                px + deltas.get(Tol.PIVOT_X, 0.0) + c * px / d,
-                py + deltas.get(Tol.PIVOT_Y, 0.0) + c * py / d,
-            ),
-            arm_length=self.arm_length + deltas.get(Tol.ARM_LENGTH, 0.0),
-            face_offset=self.face_offset + deltas.get(Tol.FACE_OFFSET, 0.0),
-            roller_radius=self.roller_radius + deltas.get(Tol.ROLLER_RADIUS, 0.0),
-        )
-
 
 def applicable(mount: Mount) -> tuple[Tol, ...]:
     """The tolerances that mean something for this follower, in :class:`Tol` order."""
@@ -178,7 +150,7 @@ def mount_of(cam: Cam) -> Mount:
     """
     if cam.conjugate is not None:
         raise DesignError("tolerance", "a conjugate pair's second plate is not supported; analyse the first")
-    kin = cam.kinematics
+    kin = cam.follower
     guide = kin.guide
     m = cam.motion(np.array([0.0]))
     element = kin.element(m)

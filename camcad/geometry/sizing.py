@@ -180,7 +180,7 @@ def min_base_radius(
     is returned.
     """
     phi = cam.sample_phi(step)
-    if cam.kinematics.guide.pivot is not None:  # an arm
+    if cam.follower.guide.pivot is not None:  # an arm
         return _arm_search(cam, phi, "base_radius", max_pressure_angle, min_curvature_radius, conjugate)
     lo = max(abs(cam.eccentricity) - cam.roller_radius, 0.0) + _RADIUS_TOL_MM
 
@@ -260,7 +260,7 @@ def min_pivot_distance(
 
     See :func:`min_base_radius` for the limits and :func:`_arm_search` for the search.
     """
-    if cam.kinematics.guide.pivot is None:
+    if cam.follower.guide.pivot is None:
         raise DesignError("follower.type", "sizing the pivot distance needs an oscillating follower")
     phi = cam.sample_phi(step)
     return _arm_search(cam, phi, "pivot_distance", max_pressure_angle, min_curvature_radius, conjugate)
@@ -282,7 +282,7 @@ def _arm_search(
     own value (the error says so); a design that meets the limits always has
     an answer, at or below its own value.
     """
-    fol = cam.follower
+    fol = cam.follower_spec
     swing = float(np.max(cam.motion(phi).s))
     r_f = cam.roller_radius
     d = fol.pivot_distance or 0.0
@@ -303,9 +303,9 @@ def _arm_search(
         trial = (
             replace(cam, base_radius=x)
             if knob == "base_radius"
-            else replace(cam, follower=replace(fol, pivot_distance=x))
+            else replace(cam, follower_spec=replace(fol, pivot_distance=x))
         )
-        if trial.follower.kind.check(trial.follower, trial.base_radius, swing) is not None:
+        if trial.follower_spec.kind.check(trial.follower_spec, trial.base_radius, swing) is not None:
             return None
         return trial
 
@@ -351,5 +351,5 @@ def _arm_search(
         side=worst.side,
         pressure_angle_max=alpha_max - m_alpha,
         curvature_radius_min=m_rho + rho_min,
-        pivot_distance=best.follower.pivot_distance,
+        pivot_distance=best.follower_spec.pivot_distance,
     )

@@ -67,7 +67,7 @@ MAX_ORDER = 90
 def _rigid_modes(cam: Cam, u: FloatArray, derivative: int) -> FloatArray:
     """(n, 3) the turn and shift modes N·JP, N_x, N_y of the design profile, or a u-derivative of them."""
     m = cam.motion(u)
-    element = cam.kinematics.element(m)
+    element = cam.follower.element(m)
     if isinstance(element, PointElement):
         base, drho = point_envelope(m.phi, element, cam.sigma)
         prof = offset_curve(base, drho, -cam.roller_radius)

@@ -1,7 +1,7 @@
 """A cam whose profile is the design corrected by a measured form error, for the fit, tool path and DXF.
 
 :class:`CompensatedCam` is the design's :class:`~camcad.geometry.cam.Cam`
-with :meth:`offset` (and so :meth:`profile`) replaced: the base curve B (a
+with :meth:`offset_curve` (and so :meth:`profile`) replaced: the base curve B (a
 roller's pitch curve, a face's profile) moved along its normal N by
 w + c(u), with c = −e(u) the correction (:func:`~camcad.inspect.actual.compensate`)
 and w the distance asked for less the roller radius, exact to the second
@@ -49,14 +49,14 @@ class CompensatedCam(Cam):
         return cls(
             program=cam.program,
             base_radius=cam.base_radius,
-            follower=cam.follower,
+            follower_spec=cam.follower_spec,
             rotation=cam.rotation,
             sample_step=cam.sample_step,
             conjugate=cam.conjugate,
             correction=correction,
         )
 
-    def offset(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
+    def offset_curve(self, phi: ArrayLike, distance: float, *, side: Side = "right") -> CurveSample:
         """The corrected profile offset outward by ``distance`` [mm] along the design's normal."""
         base, drho, profile_at = self._base_curve(phi, side)
         u = np.asarray(base.phi, dtype=float)
@@ -89,7 +89,7 @@ class CompensatedCam(Cam):
 def offset_error(cam: CompensatedCam, distance: float, phi: ArrayLike | None = None) -> float:
     """Largest distance·(1 − cos θ) [mm]: how far the path may lie off the exact offset (module notes)."""
     ph = cam.sample_phi() if phi is None else np.asarray(phi, dtype=float)
-    design = Cam.offset(cam, ph, 0.0)  # the uncorrected profile and its normal
-    corrected = cam.offset(ph, 0.0)
+    design = Cam.offset_curve(cam, ph, 0.0)  # the uncorrected profile and its normal
+    corrected = cam.offset_curve(ph, 0.0)
     cos = np.clip(np.einsum("ij,ij->i", design.normal, corrected.normal), -1.0, 1.0)
     return float(abs(distance) * np.max(1.0 - cos)) if ph.size else 0.0

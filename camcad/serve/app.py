@@ -322,7 +322,7 @@ class Designer:
         try:
             data = self.data(values)
         except DesignError as err:
-            return {"ok": False, "errors": [{"field": err.path, "message": err.message}]}
+            return {"ok": False, "errors": [{"field": err.field, "message": err.message}]}
         return evaluate(data, source=str(self.path))
 
     def save(self, values: Mapping[str, Any], revision: str = "") -> dict[str, Any]:
@@ -340,7 +340,11 @@ class Designer:
             _check_tables(data, self.folder)
             parse_design(data, source=str(self.path))
         except DesignError as err:
-            return {"saved": None, "conflict": False, "errors": [{"field": err.path, "message": err.message}]}
+            return {
+                "saved": None,
+                "conflict": False,
+                "errors": [{"field": err.field, "message": err.message}],
+            }
         with self.lock:
             if self.loaded is not loaded:  # loaded anew while this request was validated: the form is old
                 return self._conflict("was loaded again from disk after this form was filled in")
@@ -672,12 +676,8 @@ class _Handler(BaseHTTPRequestHandler):
         else:
             try:
                 data = self.server.run(designer.build_zip, values)
-            except DesignError as err:
-                errors = [{"field": err.path, "message": err.message}]
-                self._json(HTTPStatus.UNPROCESSABLE_ENTITY, {"ok": False, "errors": errors})
-                return
-            except CamcadError as err:
-                errors = [{"field": getattr(err, "field", ""), "message": str(err)}]
+            except CamcadError as err:  # bad input or a hard limit: the field as data, the message without it
+                errors = [{"field": err.field, "message": err.message}]
                 self._json(HTTPStatus.UNPROCESSABLE_ENTITY, {"ok": False, "errors": errors})
                 return
             name = f"{designer.path.stem}-shop-files.zip"

@@ -27,7 +27,7 @@ from camcad._plots.design import (
     follower_drawings,
 )
 from camcad.design import parse_design
-from camcad.errors import CamcadError, DesignError
+from camcad.errors import CamcadError
 from camcad.pipeline import analyse
 from camcad.report import alerts_html, key_numbers_html
 
@@ -82,7 +82,7 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
     pocket = analysis.parts[0].part.pocket
     groove = None
     if pocket is not None:  # as the report draws it
-        inner, outer = (_xy(cam.offset(geo.phi, flank.offset).point) for flank in pocket.flanks)
+        inner, outer = (_xy(cam.offset_curve(geo.phi, flank.offset).point) for flank in pocket.flanks)
         groove = {"outer_radius": pocket.outer_radius, "inner": inner, "outer": outer, "width": pocket.width}
     second = None
     for result in analysis.parts[1:]:  # a pair's second plate
@@ -103,7 +103,7 @@ def _drawing(analysis: Analysis) -> dict[str, Any]:
         "rotation": cam.rotation.value,
         "caption": f"To scale, cam frame at φ = 0, turning {cam.rotation.value}: the profile (filled), the "
         f"{trace_name(analysis)} (dashed), the base circle r = {cam.base_radius:g} mm (dotted) and "
-        f"{cam.kinematics.describe()} at φ = 0°, 90°, 180°, 270°." + family_caption(analysis),
+        f"{cam.follower.describe()} at φ = 0°, 90°, 180°, 270°." + family_caption(analysis),
         "profile_radius_max": float(np.hypot(*profile.T).max()),
     }
 
@@ -120,7 +120,7 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
     spec = analysis.design.dynamics
     phi = np.asarray(geo.phi)
     index = np.unique(np.linspace(0, len(phi) - 1, min(CURVE_POINTS, len(phi))).round().astype(int))
-    lift = cam.follower.kind.lift
+    lift = cam.follower_spec.kind.lift
     u, x = lift.short, lift.variable
     limit = math.degrees(geo.max_pressure_angle)
     clip = CURVATURE_CLIP * cam.base_radius
@@ -130,7 +130,7 @@ def _curves(analysis: Analysis) -> tuple[list[float | None], list[dict[str, Any]
 
     rho = one("cam profile", geo.profile.rho, clip)
     if cam.has_pitch_curve:
-        rho = one(cam.kinematics.words.path, geo.pitch.rho, clip) + rho
+        rho = one(cam.follower.words.path, geo.pitch.rho, clip) + rho
     roller = [cam.roller_radius] if cam.has_pitch_curve else []
     stress_limits = [] if spec.allowable_stress is None else [spec.allowable_stress]
     charts = [
@@ -201,10 +201,8 @@ def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
     try:
         design = parse_design(data, source=source)
         analysis = analyse(design, fit=False, toolpath=False, strict=False)
-    except DesignError as err:
-        return {"ok": False, "errors": [{"field": err.path, "message": err.message}]}
-    except CamcadError as err:  # a limit the analysis cannot get past even when not strict
-        return {"ok": False, "errors": [{"field": getattr(err, "field", ""), "message": str(err)}]}
+    except CamcadError as err:  # bad input, or a limit the analysis cannot get past even when not strict
+        return {"ok": False, "errors": [{"field": err.field, "message": err.message}]}
     summary = analysis.summary()
     phi_deg, charts = _curves(analysis)
     return {
@@ -215,7 +213,7 @@ def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
         "drawing": _drawing(analysis),
         "phi_deg": phi_deg,
         "charts": charts,
-        "lift_unit": analysis.cam.follower.kind.lift.short,
+        "lift_unit": analysis.cam.follower_spec.kind.lift.short,
         "summary": {k: summary[k] for k in ("motion", "geometry", "dynamics") if k in summary},
         "findings": [f.summary() for f in analysis.findings],
     }

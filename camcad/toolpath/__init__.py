@@ -1,6 +1,6 @@
 """The toolpath stage: plan the milling of the cam plate on the exact offset curve, and prove it.
 
-- :func:`plan_toolpath` fits the exact tool-centre path ``cam.offset(φ, r)``
+- :func:`plan_toolpath` fits the exact tool-centre path ``cam.offset_curve(φ, r)``
   with arc splines (:mod:`camcad.toolpath.arcs`), lays out roughing and
   finishing passes, leads, tabs and the bore, and raises
   :class:`~camcad.errors.GougeError` when the tool does not fit

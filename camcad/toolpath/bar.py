@@ -3,7 +3,7 @@
 The bar's blank is squared beforehand; the program mills its top edge, the
 cam, through the bar's thickness: roughing passes at the tool radius plus
 the stock to leave, one per ``step_down`` level, then one finishing pass at
-the tool radius, each along the exact offset curve ``cam.offset(φ, r)`` from
+the tool radius, each along the exact offset curve ``cam.offset_curve(φ, r)`` from
 one end of the bar to the other, entering and leaving along the edge's end
 tangents outside the bar. Climb milling (the material on the tool's left
 with a clockwise spindle) runs from the end x0 + L to the start x0,
@@ -88,7 +88,7 @@ def plan_bar(cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float
     Parameters
     ----------
     cam
-        The linear cam; its exact offset ``cam.offset(φ, r)`` is the tool path.
+        The linear cam; its exact offset ``cam.offset_curve(φ, r)`` is the tool path.
     bar
         The bar (its ends x0 and x0 + L [mm]).
     spec
@@ -116,7 +116,7 @@ def plan_bar(cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float
     lead = r + spec.tool_diameter  # the tool enters and leaves this far beyond the bar's ends [mm]
 
     def contour(distance: float) -> tuple[FloatArray, float, FloatArray, FloatArray]:
-        curve = cam.offset(phi, distance)
+        curve = cam.offset_curve(phi, distance)
         pts = np.asarray(curve.point, dtype=float)
         path, worst = chord_path(pts[::-1] if climb else pts, spec.tolerance)
         ends = curve.tangent[[-1, 0]] if climb else curve.tangent[[0, -1]]

@@ -41,10 +41,10 @@ _SNAP = 1e-3  # mm: a tab edge this close to a step's end is put there
 
 
 def offset_curve(cam: Cam, distance: float) -> CurveFn:
-    """The exact curve ``cam.offset(phi, distance)`` as point, C′, C″."""
+    """The exact curve ``cam.offset_curve(phi, distance)`` as point, C′, C″."""
 
     def evaluate(phi: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        o = cam.offset(phi, distance)
+        o = cam.offset_curve(phi, distance)
         return o.point, o.d1, o.d2
 
     return evaluate
@@ -236,7 +236,7 @@ def fit_contour(
     arcs: bool = True,
     fewest_arcs: bool = False,
 ) -> Contour:
-    """Fit, orient, round and measure the closed path ``cam.offset(phi, distance)``.
+    """Fit, orient, round and measure the closed path ``cam.offset_curve(phi, distance)``.
 
     Parameters
     ----------
@@ -267,7 +267,7 @@ def fit_contour(
         the rounded geometry (before the arc merges and tab splits, which keep
         every step on its circle or line to within 1e-4 mm). With one
         interval (no corner) the arc spline closes on itself, so the start
-        lies within the band near ``cam.offset(breaks[0], distance)``, on the
+        lies within the band near ``cam.offset_curve(breaks[0], distance)``, on the
         first arc (:func:`~camcad.toolpath.arcs.spline.fit_arc_spline`).
     """
     curve = offset_curve(cam, distance)
@@ -291,7 +291,7 @@ def offset_contour(
     clockwise: bool,
     windows: Sequence[tuple[float, float]] = (),
 ) -> Contour:
-    """The closed path ``cam.offset(phi, distance)`` as the offset of another contour's arc spline.
+    """The closed path ``cam.offset_curve(phi, distance)`` as the offset of another contour's arc spline.
 
     ``base`` is an arc-spline contour of the same cam fitted with the same
     ``breaks`` and ``windows``; its pieces are offset by
@@ -305,7 +305,7 @@ def offset_contour(
     search (the roughing contour of :func:`camcad.toolpath.plan_toolpath`).
     """
     curve = offset_curve(cam, distance)
-    at = cam.offset(np.array([breaks[0]]), base.distance)
+    at = cam.offset_curve(np.array([breaks[0]]), base.distance)
     left = float(np.sign(cross(at.tangent[0], at.normal[0])))  # +1: outward is left of increasing φ
     moved = offset_pieces(base.pieces, left * (distance - base.distance))
     if moved is not None and float(measure_deviation(curve, moved).max()) <= fit_tol:
@@ -323,7 +323,7 @@ def _realise(
     clockwise: bool,
     windows: Sequence[tuple[float, float]],
 ) -> Contour:
-    """Orient, round, measure and merge the pieces of ``cam.offset(phi, distance)`` into a contour."""
+    """Orient, round, measure and merge the pieces of ``cam.offset_curve(phi, distance)`` into a contour."""
     curve = offset_curve(cam, distance)
     reverse = (_signed_area(pieces) > 0.0) == clockwise
     steps, real = _emit(pieces, reverse=reverse, tol=tol)
@@ -338,7 +338,7 @@ def _realise(
     t_lo, t_hi = _end_tangents(pieces)
     t_start, t_end = (-t_hi, -t_lo) if reverse else (t_lo, t_hi)
     # outward: the side of the exact curve's normal where the path starts
-    outward = cam.offset(np.array([pieces.lo[0]]), distance).normal[0]
+    outward = cam.offset_curve(np.array([pieces.lo[0]]), distance).normal[0]
     normal = np.array([-t_start[1], t_start[0]])
     normal = normal if float(normal @ outward) > 0.0 else -normal
     return Contour(

@@ -1,7 +1,7 @@
 """Plan the milling of a groove (face) cam's groove with an end mill narrower than the groove.
 
 The groove's centre line is the pitch curve, the profile offset by r_f
-(``cam.offset(φ, r_f)``); its flanks are the profile offset by
+(``cam.offset_curve(φ, r_f)``); its flanks are the profile offset by
 ``inner_offset`` and ``outer_offset`` (:func:`camcad.geometry.groove.flank_offsets`).
 Any tool of radius r_t with 2 r_t < width (and r_t no larger than the flanks'
 smallest concave radius) mills it, as a CAM program clears a slot wider than
@@ -21,10 +21,10 @@ the tolerance:
    down. The tool reaches each level at the centre line's start point (in
    the slot, cut to full depth) and moves out along the normal to the pass.
 3. Inner flank finish at the full depth, tool centre on
-   ``cam.offset(φ, inner_offset + r_t)``: the material (the cam's core) lies
+   ``cam.offset_curve(φ, inner_offset + r_t)``: the material (the cam's core) lies
    inside the path, so climb milling with the spindle M3 runs clockwise
    (as around a plate's outside profile, see :mod:`camcad.toolpath.plan`).
-4. Outer flank finish, tool centre on ``cam.offset(φ, outer_offset − r_t)``:
+4. Outer flank finish, tool centre on ``cam.offset_curve(φ, outer_offset − r_t)``:
    the material lies outside the path, so climb runs counter-clockwise (as
    in a bore).
 

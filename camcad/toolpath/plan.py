@@ -1,7 +1,7 @@
 """Plan the toolpath that mills a cam plate's outside profile (and its bore) from stock.
 
 The tool-centre path is the exact profile offset outward by the tool radius,
-``cam.offset(phi, r_tool)``, approximated by arc splines within the tolerance.
+``cam.offset_curve(phi, r_tool)``, approximated by arc splines within the tolerance.
 Roughing passes step down to the full depth on the path offset by the tool
 radius plus the stock to leave; one full-depth finishing pass follows. Passes
 enter and leave on tangent arcs off the part, may leave holding tabs, and
@@ -150,7 +150,7 @@ def _tab_windows(cam: Cam, spec: GcodeSpec, phi0: float) -> list[tuple[float, fl
     if spec.tab_count == 0:
         return []
     phi = phi0 + np.linspace(0.0, TWO_PI, _DENSE + 1)
-    pts = cam.offset(phi, spec.tool_radius).point
+    pts = cam.offset_curve(phi, spec.tool_radius).point
     s = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
     total = float(s[-1])
     spacing = total / spec.tab_count
@@ -234,7 +234,7 @@ def plan_toolpath(
     Parameters
     ----------
     cam
-        The cam; its exact offset curve ``cam.offset(phi, r)`` is the tool path.
+        The cam; its exact offset curve ``cam.offset_curve(phi, r)`` is the tool path.
     spec
         Milling settings (tool, tolerance, passes, tabs, heights, feeds).
     name

@@ -6,7 +6,7 @@ end mill cutting with its side, or a grinding wheel), its axis parallel to
 the cam's, has its centre on the machine's +X half-line through the cam
 axis, X millimetres from it. Turning the cam by θ (counter-clockwise seen
 from +Z) shows the tool centre at R(−θ)·(X, 0) in the cam frame, so the tool
-follows the exact offset curve Q(φ) = ``cam.offset(φ, r_tool)`` when
+follows the exact offset curve Q(φ) = ``cam.offset_curve(φ, r_tool)`` when
 
     X = |Q(φ)|,    θ = −atan2(Q_y, Q_x)   (unwrapped),
 
@@ -169,6 +169,7 @@ def _check_cutter(cam: Cam, spec: GcodeSpec) -> float:
             f"is Ø{2.0 * largest:.4f} mm (set gcode.tool_diameter to at most that)",
             phi_range=err.phi_range,
             max_tool_radius=largest,
+            field="gcode.tool_diameter",
         ) from None
 
 
@@ -196,7 +197,7 @@ class _Path:
 
 def _polar(cam: Cam, r: float, phi: FloatArray, side: Side = "right") -> tuple[FloatArray, FloatArray]:
     """|Q| [mm] and θ = −atan2(Q_y, Q_x) [rad, wrapped] of the tool centre at cam angles φ."""
-    q = cam.offset(phi, r, side=side).point
+    q = cam.offset_curve(phi, r, side=side).point
     return np.hypot(q[:, 0], q[:, 1]), -np.arctan2(q[:, 1], q[:, 0])
 
 
@@ -219,7 +220,8 @@ def _path(cam: Cam, spec: GcodeSpec) -> _Path:
             f"gcode.machine: the tool-centre path is not star-shaped about the cam axis near cam angle "
             f"{math.degrees(bad):.2f}°: a ray from the axis meets it twice, so a tool on a line through "
             "the axis would have to turn the cam back; use machine = 'xy', a smaller tool, or a larger "
-            "cam.base_radius"
+            "cam.base_radius",
+            field="gcode.machine",
         )
     # shift whole turns so that the first rotary word lies in [0°, 360°)
     sign = 1.0 if spec.rotary_direction is Rotation.CCW else -1.0
@@ -323,7 +325,7 @@ def plan_rotary(cam: Cam, spec: GcodeSpec, *, name: str, thickness: float) -> Ro
     Parameters
     ----------
     cam
-        The cam; its exact offset ``cam.offset(φ, r_tool)`` is the tool-centre path.
+        The cam; its exact offset ``cam.offset_curve(φ, r_tool)`` is the tool-centre path.
     spec
         ``[gcode]`` with ``machine = "rotary"``: tool (end mill or wheel)
         diameter, tolerance, direction, start angle, feeds, step-down.

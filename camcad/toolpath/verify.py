@@ -148,7 +148,7 @@ def distance_to_polyline(points: FloatArray, poly: FloatArray, *, bound: float =
 
 
 class _Projector:
-    """Distance from points to an exact closed curve C(φ) = cam.offset(φ, distance).
+    """Distance from points to an exact closed curve C(φ) = cam.offset_curve(φ, distance).
 
     A k-d tree over coarse samples gives the starting φ; Newton's method on
     (C(φ) − p)·C′(φ) = 0 then finds the foot point on the exact curve.
@@ -157,16 +157,16 @@ class _Projector:
     def __init__(self, cam: Cam, distance: float) -> None:
         self.cam, self.distance = cam, distance
         self.phi = np.linspace(0.0, 2.0 * math.pi, _COARSE, endpoint=False)
-        self.points = np.asarray(cam.offset(self.phi, distance).point)
+        self.points = np.asarray(cam.offset_curve(self.phi, distance).point)
         self.tree = cKDTree(self.points)
 
     def curve(self, phi: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        o = self.cam.offset(phi, self.distance)
+        o = self.cam.offset_curve(phi, self.distance)
         return o.point, o.d1, o.d2
 
     def dense(self, n: int) -> FloatArray:
         """(n + 1, 2) closed polyline of the exact curve."""
-        return np.asarray(self.cam.offset(np.linspace(0.0, 2.0 * math.pi, n + 1), self.distance).point)
+        return np.asarray(self.cam.offset_curve(np.linspace(0.0, 2.0 * math.pi, n + 1), self.distance).point)
 
     def __call__(self, points: FloatArray, *, bound: float = math.inf) -> FloatArray:
         """Distance [mm] from (n, 2) points to the curve; ``inf`` beyond ``bound`` [mm]."""
@@ -243,7 +243,7 @@ def check_toolpath(
     the bore is a bore pass, any other a profile pass. The last profile pass
     is the finishing pass; its first and last planar moves are the leads.
     Distances to the exact curves are found by Newton projection onto
-    ``cam.offset(φ, d)``; distances from the exact curve to the path use
+    ``cam.offset_curve(φ, d)``; distances from the exact curve to the path use
     200 000 samples of the curve and the path as a polyline of 0.02 mm
     chords (error below 1e-4 mm for path radii above 0.5 mm).
     """

@@ -114,3 +114,71 @@ def test_a_velocity_jump_has_no_finite_acceleration_peak():
     ends |= {round(math.degrees(starts[i] + design.motion[i].span) % 360.0, 6) for i in moving}
     assert set(motion["velocity_jumps_deg"]) == ends
     assert motion["a_max_abs_mm_per_rad2"] is None and motion["j_max_abs_mm_per_rad3"] is None
+
+
+# Hren's tappet with the guides close to the cam (a_m = 20, b_m = 250 mm): the far guide's force N3
+# turns negative over part of the rise, where eq. 25's friction direction no longer holds
+GUIDE_FLIP = edit(edit(HREN, r"^a_m = .*$", "a_m = 20.0"), r"^b_m = .*$", "b_m = 250.0")
+
+
+def test_a_note_is_a_finding_that_changes_no_exit_code(tmp_path, capsys):
+    """What used to be a free warning string (the guide force changing side) is a NOTE finding."""
+    import json
+
+    import tomllib
+
+    from camcad.pipeline import analyse
+
+    out = tmp_path / "out"
+    assert run(tmp_path, GUIDE_FLIP, "build", "-o", str(out), "--only", "tables", "--strict") == 0
+    assert "note: guide force N3 changes side" in capsys.readouterr().err
+    found = json.loads((out / "summary.json").read_text())["findings"]
+    assert "warnings" not in json.loads((out / "summary.json").read_text())
+    (note,) = found
+    assert note["severity"] == "note" and note["field"] == "dynamics.model"
+    assert note["message"].startswith("guide force N3 changes side between")
+    # the note starts where the sampled far guide force is negative (the dynamics' own arrays)
+    dyn = analyse(parse_design(tomllib.loads(GUIDE_FLIP)), fit=False, toolpath=False).dynamics
+    i = int(np.argmin(np.abs(dyn.phi - math.radians(note["angle_deg"]))))
+    assert dyn.guide_force_far[i] < 0.0 <= dyn.guide_force_near[i]
+    assert run(tmp_path, GUIDE_FLIP, "check") == 0
+    printed = capsys.readouterr().out
+    assert "  note: guide force N3 changes side" in printed and "all design limits hold" in printed
+    assert run(tmp_path, HREN, "check") == 0  # the paper's guides: N3 stays on its side, no note
+    assert "note:" not in capsys.readouterr().out
+
+
+# Hren's tappet with friction 0.5 everywhere and its guides 10 mm apart: eq. 25's denominator at φ = 0
+# (s = v = 0, h = r_b = 50 mm) is f1·f3·b + b − f1·b·(f3 + f2) − f1·f3·a − a + f1·h·(f3 + f2)
+# = 27.5 + 110 − 55 − 25 − 100 + 25 = −17.5 mm ≤ 0: the tappet self-locks
+SELF_LOCKING = edit(
+    edit(edit(HREN, r"^a_m = .*$", "a_m = 100.0"), r"^b_m = .*$", "b_m = 110.0"),
+    r"^(f[123]) = .*$",
+    r"\1 = 0.5",
+    count=3,
+)
+
+
+def test_an_error_names_its_field_as_data_in_the_cli_and_the_designer(tmp_path, capsys):
+    """The caller that knows the TOML path sets ``.field``; the CLI line and the designer's JSON show it."""
+    import tomllib
+
+    from camcad.errors import DesignLimitError
+    from camcad.pipeline import analyse
+    from camcad.serve.payload import evaluate
+
+    design = parse_design(tomllib.loads(SELF_LOCKING))
+    with pytest.raises(DesignLimitError) as caught:
+        analyse(design, fit=False, toolpath=False, strict=False)
+    assert caught.value.field == "dynamics.b_m"
+    assert "denominator of Hren et al. eq. 25 is -17.5 mm" in caught.value.message
+    assert run(tmp_path, SELF_LOCKING, "check") == 3
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line == f"camcad: design limit: dynamics.b_m: {caught.value.message}"
+    page = evaluate(tomllib.loads(SELF_LOCKING))
+    assert page["ok"] is False
+    assert page["errors"] == [{"field": "dynamics.b_m", "message": caught.value.message}]
+    # bad input: the field the schema named, the message without it
+    bad = evaluate(tomllib.loads(edit(HREN, r"^base_radius = .*$", "base_radius = -5.0")))
+    (error,) = bad["errors"]
+    assert error["field"] == "cam.base_radius" and not error["message"].startswith("cam.base_radius")

@@ -106,7 +106,7 @@ def test_contact_force_balances_the_moment_about_the_pivot(kind: str, rotation: 
     # the force acts along the profile normal through the contact (or the roller centre)
     point = to_cam(m.phi, st.base.point if cam.has_pitch_curve else st.profile.point, -cam.sigma)
     normal = to_cam(m.phi, st.profile.normal, -cam.sigma)
-    arm = point - np.asarray(cam.kinematics.guide.pivot)
+    arm = point - np.asarray(cam.follower.guide.pivot)
     lever = -(arm[:, 0] * normal[:, 1] - arm[:, 1] * normal[:, 0])  # a rise turns the arm clockwise
     assert np.abs(result.contact_force * lever - moment).max() < 1e-9 * np.abs(moment).max()
 

@@ -172,7 +172,7 @@ def test_no_tables_no_duty():
 
 
 def test_explore_measures_read_the_new_sections():
-    """roller_life_h, min_film_ratio, motor_rms_torque for optimise and sweep; None without the table."""
+    """roller_life_h, min_film_ratio, motor_rms_torque for optimize and sweep; None without the table."""
     from camcad.explore.measures import measure_values, parse_limit
 
     analysis = pipeline.analyse(load_design(SAMPLE), fit=False, toolpath=False, strict=False)

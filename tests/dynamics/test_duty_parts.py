@@ -98,7 +98,7 @@ def _hand_l10_hours(
     if flanks is None:
         ds, load = chords(cam.profile), np.clip(force, 0.0, None)
     else:
-        inner, outer = (chords(lambda p, d=d: cam.offset(p, d)) for d in flanks)
+        inner, outer = (chords(lambda p, d=d: cam.offset_curve(p, d)) for d in flanks)
         ds, load = np.where(force < 0.0, outer, inner), np.abs(force)
     p_eq = (np.sum(load**P_EXP * ds) / np.sum(ds)) ** (1.0 / P_EXP)  # ISO 281 §7.2
     l10 = (C_RATING / p_eq) ** P_EXP  # ISO 281 §7, million revolutions
@@ -179,10 +179,10 @@ def test_a_grooves_outer_flank_film_has_that_flanks_curvature(groove):
     inner = -0.5 * clearance
 
     def outer_at(p):
-        return cam.offset(p, outer)
+        return cam.offset_curve(p, outer)
 
     def inner_at(p):
-        return cam.offset(p, inner)
+        return cam.offset_curve(p, inner)
 
     force = np.asarray(dyn.contact_force)
     back = np.flatnonzero(force < 0.2 * force.min())  # the outer flank pushes the roller back

@@ -88,7 +88,7 @@ def test_jump_is_reported_with_its_remedies():
     assert 45.0 < start < 90.0
     assert 180.0 < end < 225.0
     assert len(result.jump_ranges) == 2
-    warning = summary["warnings"][0]
+    warning = result.findings[0].message
     preload = math.ceil(result.min_preload * 10) / 10
     speed = math.floor(result.speed_range_rpm[1] * 10) / 10
     assert warning.startswith(f"follower jumps between {start:.1f}° and {end:.1f}° (contact force ")
@@ -121,7 +121,7 @@ def test_tappet_speed_limit_and_preload_deflection():
     fast = analyse(with_speed(design, 1.05 * high))
     assert fast.jump
     assert fast.preload_deflection == pytest.approx(fast.min_preload / 31.6)
-    assert "preload deflection ≥" in fast.warnings[0]
+    assert "preload deflection ≥" in fast.findings[0].message
     fixed = analyse(
         with_dynamics(with_speed(design, 1.05 * high), preload_deflection=fast.preload_deflection)
     )

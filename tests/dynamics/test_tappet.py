@@ -186,7 +186,7 @@ def test_table1_stroke_maximum_against_exact_dudley_polynomial():
     """Maximum drive torque over the stroke, checked independently.
 
     Independent route: the monomial coefficients of Hren et al. eqs. 7-12, the
-    3×3 system (eqs. 17, 18, 20) and a bounded scalar optimiser. The sampled
+    3×3 system (eqs. 17, 18, 20) and a bounded scalar optimizer. The sampled
     maximum (0.1° grid) must agree with the continuous one.
     """
     design = table1_design()

@@ -63,7 +63,7 @@ def test_002_optimum_equals_brute_force_grid(case_002):
     # more than the slope of r_b(e) times the step (< 3 mm/mm here)
     assert radii[i] - 3.0 * step <= r_b <= radii[i] + 1e-5
     assert abs(e - grid[i]) <= step
-    assert r_b == pytest.approx(23.42, abs=0.01)  # the number docs/guides/optimisation.md quotes
+    assert r_b == pytest.approx(23.42, abs=0.01)  # the number docs/guides/optimization.md quotes
 
 
 def test_002_optimum_is_limited_by_both_sides_of_the_pressure_angle(case_002):

@@ -3,7 +3,7 @@
 The polylines of ``profile_poly.dxf`` (read back with ezdxf) and the outline
 of ``cam.stl`` (read back with trimesh and cut at mid-height) are measured,
 vertices and points along every chord, against the exact curve
-``cam.offset(φ, d)`` evaluated densely from the geometry (100 000 points, so
+``cam.offset_curve(φ, d)`` evaluated densely from the geometry (100 000 points, so
 the dense polygon's own sagitta is below 1e-8 mm), never against the fitted
 spline. Before the fix the chord error was measured against the spline and
 the fit's certified error came on top (5.02–5.74 µm for 5 µm).
@@ -37,7 +37,7 @@ def exact(name: str, plate: int, offset: float) -> np.ndarray:
     result = built(name)
     cam = result.analysis.parts[plate - 1].part.cam
     phi = np.linspace(0.0, 2.0 * math.pi, _DENSE, endpoint=False)
-    return np.asarray(cam.offset(phi, offset).point)
+    return np.asarray(cam.offset_curve(phi, offset).point)
 
 
 _BUILT: dict[str, object] = {}

@@ -225,4 +225,7 @@ def test_pressure_angle_over_the_limit_is_a_warning_with_angles():
     cam = Cam.from_design(make_design(law="cycloidal", base_radius=20.0, roller_radius=5.0, lift=30.0))
     geo = analyse_geometry(cam, max_pressure_angle=math.radians(30))
     assert geo.undercut is None
-    assert any(w.startswith("pressure angle reaches") and "°–" in w for w in geo.warnings)
+    assert any(
+        w.startswith("pressure angle reaches") and "°–" in w
+        for w in (f.message for f in geo.findings if not f.hard)
+    )

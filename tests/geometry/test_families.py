@@ -70,7 +70,7 @@ def test_groove_pocket_flanks_lie_at_half_width_from_the_pitch_curve(clearance: 
     phi = np.linspace(0.0, 2.0 * math.pi, 61, endpoint=False) + 0.013
     inner, outer = part.pocket.flanks
     for flank, sign in ((inner, -1.0), (outer, 1.0)):
-        points = np.asarray(cam.offset(phi, flank.offset).point)
+        points = np.asarray(cam.offset_curve(phi, flank.offset).point)
         gap = distance_to_polygon(points, pitch)
         assert np.abs(gap - (r_f + 0.5 * clearance)).max() < 1e-6, flank.name
         # the inner flank is nearer the cam axis than the pitch curve, the outer farther

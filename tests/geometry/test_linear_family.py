@@ -198,12 +198,12 @@ ARM = {"type": "oscillating-roller", "roller_radius": RF, "pivot_distance": 90.0
 def test_oscillating_rollers_pressure_angle_from_the_pitch_lines_numerical_normal():
     """|α| is the angle between the pitch line's normal and the arm's perpendicular at the roller centre."""
     cam = bar_cam(linear_data(follower=ARM))
-    pivot = np.asarray(cam.kinematics.guide.pivot)
+    pivot = np.asarray(cam.follower.guide.pivot)
     phi = np.linspace(0.05, 2.05, 4001)  # inside the rise
     pitch = np.asarray(cam.pitch(phi).point)
     tangent = np.gradient(pitch, phi, axis=0, edge_order=2)
     normal = np.column_stack((-tangent[:, 1], tangent[:, 0]))
-    centre = np.asarray(cam.kinematics.element(cam.motion(phi)).m0)  # machine frame (the arm does not move x)
+    centre = np.asarray(cam.follower.element(cam.motion(phi)).m0)  # machine frame (the arm does not move x)
     arm = centre - pivot
     across = np.column_stack((-arm[:, 1], arm[:, 0]))
     cos = np.abs(np.einsum("ij,ij->i", normal, across)) / (np.hypot(*normal.T) * np.hypot(*across.T))

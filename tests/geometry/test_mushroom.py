@@ -163,7 +163,7 @@ def test_face_width_must_cover_the_contacts_slide():
 def test_its_contact_stress_radius_is_the_face_radius_and_it_slides():
     design = parse_design(mushroom(face_radius=55.0))
     assert design.dynamics_setup().roller_radius == 55.0  # Hertz: 1/R = 1/ρ_cam + 1/ρ_f
-    kin = Cam.from_design(design).kinematics
+    kin = Cam.from_design(design).follower
     assert kin.contact_radius == 55.0 and not kin.rolls and kin.arm_direction is None
     assert dict(kin.rows())["face radius [mm]"] == 55.0
 

@@ -44,12 +44,12 @@ def roller_cam(rotation: Rotation, *, d: float = 120.0, arm: float = 90.0, lift:
     spec = FollowerSpec(
         kind=FOLLOWER_TYPES["oscillating-roller"], roller_radius=15.0, pivot_distance=d, arm_length=arm
     )
-    return Cam(program=program(lift), base_radius=50.0, follower=spec, rotation=rotation)
+    return Cam(program=program(lift), base_radius=50.0, follower_spec=spec, rotation=rotation)
 
 
 def flat_cam(rotation: Rotation, *, f: float = 5.0) -> Cam:
     spec = FollowerSpec(kind=FOLLOWER_TYPES["oscillating-flat"], pivot_distance=130.0, face_offset=f)
-    return Cam(program=program(10.0), base_radius=40.0, follower=spec, rotation=rotation)
+    return Cam(program=program(10.0), base_radius=40.0, follower_spec=spec, rotation=rotation)
 
 
 PHI = np.linspace(0.0, 2.0 * math.pi, 181, endpoint=False) + 0.013
@@ -58,7 +58,7 @@ PHI = np.linspace(0.0, 2.0 * math.pi, 181, endpoint=False) + 0.013
 @pytest.mark.parametrize("rotation", ROTATIONS)
 def test_roller_convention_and_pitch_on_the_arm_circle(rotation: Rotation) -> None:
     cam = roller_cam(rotation)
-    k = cam.kinematics
+    k = cam.follower
     pivot = np.asarray(k.pivot)
     # the convention: roller centre on +y at r_b + r_f at φ = 0, pivot to its right at d and l
     start = cam.pitch(np.array([0.0])).point[0]
@@ -94,7 +94,7 @@ def test_profile_at_roller_radius_from_the_pitch_curve(rotation: Rotation) -> No
 def test_roller_pressure_angle_closed_form_and_vectors(rotation: Rotation) -> None:
     cam = roller_cam(rotation)
     st = cam.state(PHI)
-    k = cam.kinematics
+    k = cam.follower
     beta = k.arm_angle(st.motion)
     dpsi = np.radians(st.motion.v)
     d, arm = 120.0, 90.0
@@ -136,7 +136,7 @@ def test_flat_contact_and_curvature_closed_forms(rotation: Rotation) -> None:
     st = cam.state(PHI)
     m = st.motion
     dpsi, ddpsi = np.radians(m.v), np.radians(m.a)
-    px, py = cam.kinematics.pivot
+    px, py = cam.follower.pivot
     # β: the angle between the line pivot → cam axis and the face
     beta = np.radians(m.s) + math.atan2(py, px)
     sense = 1.0 if rotation is Rotation.CCW else -1.0  # the face turns against a ccw cam
@@ -150,7 +150,7 @@ def test_flat_contact_and_curvature_closed_forms(rotation: Rotation) -> None:
 def test_flat_contact_is_the_limit_of_neighbouring_face_lines(rotation: Rotation) -> None:
     """The contact point as the intersection of the face lines at φ ± h (a numerical envelope)."""
     cam = flat_cam(rotation)
-    k = cam.kinematics
+    k = cam.follower
     h = 1e-6
     for phi in PHI[::10]:
         lines = []
@@ -171,12 +171,12 @@ def test_a_very_long_arm_becomes_a_slide(rotation: Rotation) -> None:
     for arm in (2.0e3, 2.0e4, 2.0e5):
         swing = math.degrees(lift / arm)  # the roller travels lift mm along its arc
         rocker = roller_cam(rotation, d=arm + delta, arm=arm, lift=swing)
-        k = rocker.kinematics
+        k = rocker.follower
         start = np.array([0.0, 65.0])
         u = -np.array([-(start - k.pivot)[1], (start - k.pivot)[0]]) / arm  # driven direction at ψ = 0
         e = -float(start @ np.array([-u[1], u[0]]))  # distance of the slide's line from the axis
         spec = FollowerSpec(kind=FOLLOWER_TYPES["translating-roller"], roller_radius=15.0, eccentricity=e)
-        slide = Cam(program=program(lift), base_radius=50.0, follower=spec, rotation=rotation)
+        slide = Cam(program=program(lift), base_radius=50.0, follower_spec=spec, rotation=rotation)
         a, b = rocker.state(PHI), slide.state(PHI)
         errors.append(
             max(
@@ -209,10 +209,10 @@ def test_sizing_the_base_radius_and_the_pivot_against_a_scan() -> None:
             trial = (
                 replace(cam, base_radius=float(x))
                 if knob == "base_radius"
-                else replace(cam, follower=replace(cam.follower, pivot_distance=float(x)))
+                else replace(cam, follower_spec=replace(cam.follower_spec, pivot_distance=float(x)))
             )
             r0 = trial.base_radius + 15.0
-            d, arm = trial.follower.pivot_distance, 90.0
+            d, arm = trial.follower_spec.pivot_distance, 90.0
             if d is None or not (abs(d - arm) <= r0 <= d + arm):
                 continue
             margin = feasible_margins(trial, phi, max_pressure_angle=alpha, min_curvature_radius=0.0)[0]

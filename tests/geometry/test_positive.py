@@ -123,13 +123,13 @@ def test_groove_loops_are_hard_findings_naming_the_base_radius(
 
 def _machine_centres(cam: Cam, partner: Cam, phi: np.ndarray, design: Any) -> tuple[np.ndarray, np.ndarray]:
     """Both roller centres in the machine frame, built from the first follower's motion alone."""
-    first = cam.kinematics.trace(cam.motion(phi)).m0  # machine frame (tested in test_oscillating/test_cam)
+    first = cam.follower.trace(cam.motion(phi)).m0  # machine frame (tested in test_oscillating/test_cam)
     conj = design.conjugate
-    pivot = cam.kinematics.guide.pivot
+    pivot = cam.follower.guide.pivot
     if pivot is None:  # a yoke: the second roller rides rigidly with the first
         joints = np.array([bp.phi for bp in cam.program.breakpoints])  # the top of a lift is at a joint
         top_phi = joints[np.argmax(cam.motion(joints).s)]
-        top = cam.kinematics.trace(cam.motion(np.array([top_phi]))).m0[0]
+        top = cam.follower.trace(cam.motion(np.array([top_phi]))).m0[0]
         r2 = conj.roller_radius or cam.roller_radius
         c, s = math.cos(conj.angle), math.sin(conj.angle)
         u = top / np.hypot(*top)
@@ -169,11 +169,11 @@ def test_both_rollers_touch_their_plates_at_every_angle(
     assert distance_to_polygon(seen1, plate1).min() > r1 - 1e-4
     assert distance_to_polygon(seen2, plate2).min() > r2 - 1e-4
     # the tie is rigid: a yoke keeps its centres' distance, two arms keep their length on one pivot
-    if cam.kinematics.guide.pivot is None:
+    if cam.follower.guide.pivot is None:
         gap = np.hypot(*(m2 - m1).T)
         assert np.ptp(gap) < 1e-9
     else:
-        pivot = np.asarray(cam.kinematics.guide.pivot)
+        pivot = np.asarray(cam.follower.guide.pivot)
         assert np.abs(np.hypot(*(m2 - pivot).T) - 100.0).max() < 1e-9
 
 

@@ -117,8 +117,8 @@ def test_pressure_angle_is_quang_eq_4_and_offset_curvature_is_that_of_its_points
     smooth = phi[_away_from_joints(cam, phi)]
     c1, _ = _fd(cam.pitch, smooth)
     for distance in (0.0, 3.0):
-        off = cam.offset(smooth, distance)
-        p1, p2 = _fd(lambda x, dist=distance: cam.offset(x, dist), smooth)
+        off = cam.offset_curve(smooth, distance)
+        p1, p2 = _fd(lambda x, dist=distance: cam.offset_curve(x, dist), smooth)
         forward = np.sign(np.sum(p1 * c1, axis=1))
         speed = np.hypot(*p1.T)
         kappa = forward * turning * (p1[:, 0] * p2[:, 1] - p1[:, 1] * p2[:, 0]) / speed**3
@@ -133,8 +133,8 @@ def test_offset_curve_derivative_matches_its_points(d, phi0):
     cam = build(d)
     assume(all(abs(math.remainder(phi0 - bp.phi, 2 * math.pi)) > 1e-3 for bp in cam.program.breakpoints))
     h = 1e-5
-    pts = cam.offset(np.array([phi0 - h, phi0 + h]), 4.0).point
-    here = cam.offset(np.array([phi0]), 4.0)
+    pts = cam.offset_curve(np.array([phi0 - h, phi0 + h]), 4.0).point
+    here = cam.offset_curve(np.array([phi0]), 4.0)
     assert_allclose((pts[1] - pts[0]) / (2 * h), here.d1[0], rtol=1e-6, atol=1e-6)
-    d1 = cam.offset(np.array([phi0 - h, phi0 + h]), 4.0).d1
+    d1 = cam.offset_curve(np.array([phi0 - h, phi0 + h]), 4.0).d1
     assert_allclose((d1[1] - d1[0]) / (2 * h), here.d2[0], rtol=1e-5, atol=1e-5)

@@ -28,7 +28,7 @@ def _wave(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def test_a_constant_correction_is_an_offset(any_cam, c, side):
     phi = any_cam.sample_phi()
     fixed = CompensatedCam.of(any_cam, _constant(c))
-    want, got = any_cam.offset(phi, 3.0 + c, side=side), fixed.offset(phi, 3.0, side=side)
+    want, got = any_cam.offset_curve(phi, 3.0 + c, side=side), fixed.offset_curve(phi, 3.0, side=side)
     for name in ("point", "d1", "d2", "normal", "tangent"):
         np.testing.assert_allclose(getattr(got, name), getattr(want, name), atol=1e-9, err_msg=name)
     finite = np.isfinite(want.rho) & (np.abs(want.rho) < 1e6)
@@ -39,7 +39,7 @@ def test_a_constant_correction_is_an_offset(any_cam, c, side):
 def test_a_varying_correction_is_the_made_curve_and_its_derivatives_are_exact(any_cam):
     u = np.linspace(0.05, 2 * np.pi - 0.05, 997)
     corrected = CompensatedCam.of(any_cam, _wave)
-    got = corrected.offset(u, 0.0)
+    got = corrected.offset_curve(u, 0.0)
     made = made_curve(any_cam, u, np.full(u.size, -any_cam.roller_radius), _wave)
     np.testing.assert_allclose(got.point, made.x, atol=1e-10)
     np.testing.assert_allclose(got.d1, made.d1, atol=1e-9)
@@ -48,6 +48,6 @@ def test_a_varying_correction_is_the_made_curve_and_its_derivatives_are_exact(an
     h = 1e-5  # central differences away from the joints (the test's own check, not the code's)
     joints = np.array([bp.phi for bp in any_cam.program.breakpoints])
     away = np.min(np.abs(np.subtract.outer(u, joints)), axis=1) > 1e-3
-    up, down = corrected.offset(u + h, 0.0), corrected.offset(u - h, 0.0)
+    up, down = corrected.offset_curve(u + h, 0.0), corrected.offset_curve(u - h, 0.0)
     np.testing.assert_allclose(((up.point - down.point) / (2 * h))[away], got.d1[away], atol=1e-5)
     np.testing.assert_allclose(((up.d1 - down.d1) / (2 * h))[away], got.d2[away], atol=1e-4)

@@ -194,7 +194,7 @@ def brute_min_jerk(degree: int, beta: float, conditions: list[tuple[float, int, 
 
 
 @pytest.mark.parametrize("degree", [6, 8, 9])
-def test_minimum_jerk_polynomial_against_a_brute_force_optimisation(degree):
+def test_minimum_jerk_polynomial_against_a_brute_force_optimization(degree):
     """degree > lowest: least ∫ j² dφ subject to the blend conditions, against SLSQP on monomials."""
     cv_lift, cv_span = 20.0, 80.0
     v = cv_lift / RAD(cv_span)

@@ -3,7 +3,7 @@
 The harness is :mod:`tests.readers.test_rs274`'s (``rs274 -t TOOLS -g FILE OUT``).
 From the canonical output alone (:func:`parse_canon`), the tool-centre path
 is rebuilt and measured against dense polylines of the exact flank curves
-``cam.offset(φ, d)`` (:func:`tests.toolpath.test_groove.prove`), independent
+``cam.offset_curve(φ, d)`` (:func:`tests.toolpath.test_groove.prove`), independent
 of the arc fit: the flank passes hold the tool's edge on each flank within
 ``gcode.tolerance``, nothing comes closer than r_t − tol to either flank or
 leaves the groove, the slot reaches −depth and no deeper, no rapid runs below

@@ -2,7 +2,7 @@
 
 The canonical moves rs274 executes are rebuilt into the finishing pass (the
 last run of feed moves at the full depth) and measured against the exact
-offset of the bar's edge, ``cam.offset(φ, r)``, both ways.
+offset of the bar's edge, ``cam.offset_curve(φ, r)``, both ways.
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ def test_rs274_runs_the_bar_program_and_its_finishing_pass_is_the_exact_offset(t
     (designed,) = family_of(design.cam.style).parts(Cam.from_design(design), design.family_options())
     cam = designed.cam
     r = design.gcode.tool_radius
-    exact = np.asarray(cam.offset(np.linspace(0.0, 2 * np.pi, 40001), r).point)
+    exact = np.asarray(cam.offset_curve(np.linspace(0.0, 2 * np.pi, 40001), r).point)
     # exact -> path: distance to the nearest segment of the path (brute force over all segments)
     a, b = path[:-1], path[1:]
     ab = b - a

@@ -98,8 +98,8 @@ def proven(design, text: str, tmp_path: Path, *, dialect_end: str = "M2") -> lis
     cam = Cam.from_design(design)
     sign = 1.0 if spec.rotary_direction.value == "ccw" else -1.0
     phi = np.linspace(0.0, 2.0 * math.pi, DENSE, endpoint=False)
-    exact = cam.offset(phi, spec.tool_radius).point
-    profile = cam.offset(phi, 0.0).point
+    exact = cam.offset_curve(phi, spec.tool_radius).point
+    profile = cam.offset_curve(phi, 0.0).point
     levels = list(dict.fromkeys(m["end"][1] for m in cuts))  # in cutting order, top first
     revolution = len(cuts) // len(levels)
     first = cuts[:revolution]
@@ -116,8 +116,8 @@ def proven(design, text: str, tmp_path: Path, *, dialect_end: str = "M2") -> lis
         assert np.allclose([m["end"][2] - k * turn for m in rev], [m["end"][2] for m in first], atol=1e-4)
     # block times: 1/F minutes = contact length / feed, the contact length found independently
     fine = np.linspace(0.0, 2.0 * math.pi, 20 * DENSE, endpoint=False)  # ~3e-4 mm apart
-    tree = cKDTree(cam.offset(fine, spec.tool_radius).point)
-    fine_profile = cam.offset(fine, 0.0).point
+    tree = cKDTree(cam.offset_curve(fine, spec.tool_radius).point)
+    fine_profile = cam.offset_curve(fine, 0.0).point
     step = np.hypot(*np.diff(np.vstack((fine_profile, fine_profile[:1])), axis=0).T)
     arc = np.concatenate(([0.0], np.cumsum(step)))  # profile length from φ = 0 on the fine grid
     perimeter = arc[-1]

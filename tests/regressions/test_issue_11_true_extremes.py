@@ -55,14 +55,15 @@ def test_jump_just_before_the_joint_is_found_with_the_right_advice():
     assert preload_needed == pytest.approx(5.5, abs=0.02)
     assert top_rpm == pytest.approx(140.0, abs=0.05)
 
-    dyn = analyse(jump_design(), fit=False, toolpath=False, strict=False).summary()["dynamics"]
+    analysis = analyse(jump_design(), fit=False, toolpath=False, strict=False)
+    dyn = analysis.summary()["dynamics"]
     assert dyn["jump"] is True
     assert dyn["contact_force_min_N"] == pytest.approx(force, rel=1e-9)
     assert dyn["contact_force_min_angle_deg"] == pytest.approx(90.0)
     assert dyn["contact_force_min_side"] == "before joint"
     assert dyn["min_preload_N"] == pytest.approx(preload_needed, rel=1e-9)
     assert dyn["speed_range_rpm"][1] == pytest.approx(top_rpm, rel=1e-9)
-    warning = dyn["warnings"][0]
+    (warning,) = [f.message for f in analysis.findings if f.kind == "jump"]
     assert "at 90.0° (just before the joint)" in warning
     assert f"raise the preload to ≥ {math.ceil(preload_needed * 10) / 10:.1f} N" in warning  # rounded up
     assert f"keep the speed ≤ {math.floor(top_rpm * 10) / 10:.1f} rpm" in warning  # rounded down

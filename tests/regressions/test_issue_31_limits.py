@@ -1,7 +1,7 @@
 """Issue 31, "size, check and optimize agree on one limit set", with every plate and flank held to it.
 
 - conjugate pair with a smaller second roller: the second plate's Hertz stress
-  binds; the optimiser's optimum sits where that stress meets the limit, found
+  binds; the optimizer's optimum sits where that stress meets the limit, found
   here by a root search on the analysis' own second-plate figure (brentq),
   and it passes ``camcad check``;
 - groove driven on its outer flank: the sweep's ``contact_stress`` is the

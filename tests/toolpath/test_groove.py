@@ -1,7 +1,7 @@
 """Groove milling (issue 15): slot with a ramp, then both flanks finished, proved on the exact flanks.
 
 The truth is the exact geometry, not the fit: the flanks are dense polylines
-of ``cam.offset(φ, d)`` at the flank offsets (the pitch curve ∓ (r_f + c/2),
+of ``cam.offset_curve(φ, d)`` at the flank offsets (the pitch curve ∓ (r_f + c/2),
 :func:`camcad.geometry.groove.flank_offsets`), and the program's motion is
 rebuilt here from the written G-code (read back by :func:`parse_gcode`;
 ``tests/readers/test_rs274_groove.py`` rebuilds it from LinuxCNC's canonical
@@ -71,9 +71,9 @@ def sample() -> tuple[Design, Cam, Toolpath]:
 
 
 def exact(cam: Cam, distance: float) -> np.ndarray:
-    """(n, 2) dense points of the exact curve ``cam.offset(φ, distance)``, closed."""
+    """(n, 2) dense points of the exact curve ``cam.offset_curve(φ, distance)``, closed."""
     phi = np.linspace(0.0, 2.0 * math.pi, _DENSE + 1)
-    return np.asarray(cam.offset(phi, distance).point)
+    return np.asarray(cam.offset_curve(phi, distance).point)
 
 
 def points(move: Move) -> np.ndarray:
@@ -194,7 +194,7 @@ def prove(moves: list[Move], cam: Cam, design: Design) -> Proof:
     closest = min(float(_nearest(flank, cutting[:, :2])[0].min()) for flank in (inner, outer))
     off_centre = float(_nearest(pitch, cutting[:, :2])[0].max())
     lap = _planar(exact(cam, cam.roller_radius))
-    start = np.asarray(cam.offset(np.array([spec.start_angle]), cam.roller_radius).point[0])
+    start = np.asarray(cam.offset_curve(np.array([spec.start_angle]), cam.roller_radius).point[0])
     ramp = [m for m in feeds if m.end[2] < m.start[2] - 1e-9 and math.dist(m.start[:2], m.end[:2]) > 1e-9]
     slope = max((m.start[2] - m.end[2]) / _planar(points(m)) for m in ramp)
     passes = tuple(m.end[2] for m in feeds if math.dist(m.end[:2], start) < 1e-3 and m.end[2] <= 0.0)

@@ -1,7 +1,7 @@
 """The toolpath planner: passes, leads, tabs, bore, limits; every program is proved against the exact cam.
 
 The proof (:func:`check_toolpath`) runs on the program as written and read
-back by the G-code reader, and measures it against ``cam.offset(φ, r)``.
+back by the G-code reader, and measures it against ``cam.offset_curve(φ, r)``.
 """
 
 from __future__ import annotations
@@ -86,14 +86,14 @@ def profile_passes(tp: Toolpath) -> list[list]:
 @pytest.mark.parametrize("config", [c for c in ALL if c != "start-75-no-stock"])
 def test_roughing_contour_is_within_tolerance_of_its_own_exact_offset(config):
     # the roughing contour is the finishing arc spline offset by the stock (issue 18); measured here
-    # against the exact curve cam.offset(φ, r + stock), two-way, on dense samples of both (the
+    # against the exact curve cam.offset_curve(φ, r + stock), two-way, on dense samples of both (the
     # exact curve at 200 000 φ, the moves every 0.02 mm), leads excluded
     design, cam, tp = planned(config)
     *rough, finish = profile_passes(tp)
     assert rough and tp.rough_offset > design.gcode.tool_radius
     planar = [m for m in rough[-1] if m.kind.is_arc or m.start[:2] != m.end[:2]][1:-1]
     path = np.vstack([densify(m) for m in planar])[:, :2]
-    exact = np.asarray(cam.offset(np.linspace(0.0, 2.0 * math.pi, 200_001), tp.rough_offset).point)
+    exact = np.asarray(cam.offset_curve(np.linspace(0.0, 2.0 * math.pi, 200_001), tp.rough_offset).point)
     tol = design.gcode.tolerance
     assert distance_to_polyline(path, exact).max() <= tol
     assert distance_to_polyline(exact[::4], path).max() <= tol
@@ -117,7 +117,7 @@ def test_roughing_contour_is_fitted_afresh_when_the_offset_spline_cannot_be_used
     *rough, _ = profile_passes(tp)
     planar = [m for m in rough[-1] if m.kind.is_arc or m.start[:2] != m.end[:2]][1:-1]
     path = np.vstack([densify(m) for m in planar])[:, :2]
-    exact = np.asarray(cam.offset(np.linspace(0.0, 2.0 * math.pi, 200_001), tp.rough_offset).point)
+    exact = np.asarray(cam.offset_curve(np.linspace(0.0, 2.0 * math.pi, 200_001), tp.rough_offset).point)
     assert distance_to_polyline(path, exact).max() <= design.gcode.tolerance
     assert distance_to_polyline(exact[::4], path).max() <= design.gcode.tolerance
 

@@ -84,7 +84,7 @@ def cam_frame_path(x: np.ndarray, words: np.ndarray, *, sign: float, spacing: fl
 
 def exact_polygon(cam: Cam, distance: float, n: int = DENSE) -> np.ndarray:
     phi = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
-    return cam.offset(phi, distance).point
+    return cam.offset_curve(phi, distance).point
 
 
 def hausdorff(path: np.ndarray, exact: np.ndarray) -> float:
@@ -149,7 +149,7 @@ def test_any_design_is_cut_within_tolerance(
     path = cam_frame_path(tp.x, tp.rotary_words, sign=sign_of(tp))
     assert hausdorff(path, exact_polygon(cam, design.gcode.tool_radius)) <= tolerance
     assert tp.x[0] == pytest.approx(
-        float(np.hypot(*cam.offset(np.radians([start]), tool_diameter / 2).point[0])), abs=6e-5
+        float(np.hypot(*cam.offset_curve(np.radians([start]), tool_diameter / 2).point[0])), abs=6e-5
     )
 
 
@@ -161,7 +161,7 @@ class _Loop:
     def sample_phi(self, step: float) -> np.ndarray:
         return np.arange(0.0, 2.0 * math.pi, step)
 
-    def offset(self, phi, distance, side="right"):
+    def offset_curve(self, phi, distance, side="right"):
         phi = np.asarray(phi, dtype=float)
 
         class _Points:
@@ -189,7 +189,7 @@ def test_the_measurement_is_not_vacuous():
 def test_start_block_is_the_exact_tool_centre_at_the_start_angle():
     """Closed form: the first words are |Q(φ0)| and −atan2(Q) of the exact offset point at start_angle."""
     cam, tp = planned("concave", "wheel-fine")
-    q = cam.offset(np.array([math.radians(200.0)]), tp.spec.tool_radius).point[0]
+    q = cam.offset_curve(np.array([math.radians(200.0)]), tp.spec.tool_radius).point[0]
     assert tp.x[0] == pytest.approx(math.hypot(*q), abs=5e-5)
     expected = math.degrees(-math.atan2(q[1], q[0])) % 360.0
     assert tp.rotary_words[0] == pytest.approx(expected, abs=1e-6)
@@ -345,11 +345,11 @@ def _ray_crossing(cam: Cam, distance: float, theta: float, sign: float, dense: n
     k = np.flatnonzero((np.sign(cross[:-1]) != np.sign(cross[1:])) & ahead[:-1])[0]
 
     def f(p: float) -> float:
-        q = cam.offset(np.array([p]), distance).point[0]
+        q = cam.offset_curve(np.array([p]), distance).point[0]
         return float(u[0] * q[1] - u[1] * q[0])
 
     root = brentq(f, phi[k], phi[k + 1], xtol=1e-14)
-    return float(np.hypot(*cam.offset(np.array([root]), distance).point[0]))
+    return float(np.hypot(*cam.offset_curve(np.array([root]), distance).point[0]))
 
 
 @pytest.mark.parametrize("case", ["poly345-offset-ccw", "cycloidal-cw", "concave"])

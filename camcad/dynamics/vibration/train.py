@@ -120,16 +120,6 @@ class Train:
         readonly(out)
         return out
 
-    def static_output(self, s: FloatArray) -> FloatArray:
-        """Output at rest with the contact held at lift ``s`` [generalised units] (a dwell's rest)."""
-        _, _, k = self.matrices()
-        load = np.asarray(self.weight, dtype=float).copy()
-        load[-1] += self.preload
-        kinv = np.linalg.inv(k)
-        # K q = e₀ k_f s − load
-        out = kinv[-1, 0] * self.contact_rate * np.asarray(s, dtype=float) - kinv[-1] @ load
-        return np.asarray(out, dtype=float)
-
 
 def train_from_specs(vib: VibrationSpec, dyn: DynamicsSpec, *, arm_angle: float | None = None) -> Train:
     """Build the train a ``[vibration]`` and a ``[dynamics]`` table describe.

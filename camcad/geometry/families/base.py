@@ -90,7 +90,7 @@ class Flank:
     """A further curve of a part, fitted and drawn beside its outline: an offset of its cam's profile.
 
     ``name`` keys its fit in ``summary.json``; ``layer`` is its DXF layer;
-    ``offset`` [mm] the distance from the profile (``Cam.offset(φ, offset)``).
+    ``offset`` [mm] the distance from the profile (``Cam.offset_curve(φ, offset)``).
     """
 
     name: str

@@ -77,9 +77,7 @@ class ConjugateFamily:
         """What the second plate drives (nothing for a single plate)."""
         second = parts[1]
         return (
-            f" The second plate (outline) drives the {second.cam.kinematics.describe()}."
-            if second.made
-            else ""
+            f" The second plate (outline) drives the {second.cam.follower.describe()}." if second.made else ""
         )
 
 

@@ -73,8 +73,8 @@ class LinearFamily:
             rollers = " or ".join(sorted(t.word for t in FOLLOWER_TYPES.values() if t.two_sided))
             raise DesignError(
                 "follower.type",
-                f"{bar_cam.follower.kind.word}: a flat face has no envelope on a linear cam (it does not "
-                f"turn relative to the bar); allowed: {rollers} or a curved face",
+                f"{bar_cam.follower_spec.kind.word}: a flat face has no envelope on a linear cam (it does "
+                f"not turn relative to the bar); allowed: {rollers} or a curved face",
             )
         bar = _bar(bar_cam, options)
         phi = np.linspace(0.0, TWO_PI, BAR_SAMPLES)

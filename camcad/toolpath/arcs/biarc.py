@@ -1,7 +1,7 @@
 """Biarcs and the machinery to measure arc paths against an exact curve.
 
 The curve is any smooth plane curve C(φ) given with its first two
-φ-derivatives (for camcad: ``cam.offset(phi, tool_radius)``). A biarc
+φ-derivatives (for camcad: ``cam.offset_curve(phi, tool_radius)``). A biarc
 replaces a φ-interval by two circular arcs that meet the curve's end points
 and end tangents and join each other tangentially; :func:`measure_deviation`
 gives the two-way distance between pieces and the curve, measured on samples
