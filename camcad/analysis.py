@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from camcad.dynamics.vibration import VibrationResult
     from camcad.export.gcode import GcodeProgram
     from camcad.fea.results import FeaResult  # only typing: the FE package loads when the check runs
+    from camcad.fit.surface import BarrelWallFit
     from camcad.toolpath import Toolpath
 
 __all__ = ["Analysis", "PartResult", "motion_summary"]
@@ -54,6 +55,8 @@ class PartResult:
         The certified NURBS of its further curves (``part.flanks``), in order; empty when not fitted.
     gcode
         Its program; None without a tool path, or when not made.
+    wall_fit
+        A barrel's certified wall surfaces (:class:`~camcad.fit.surface.BarrelWallFit`), else None.
     """
 
     part: Part
@@ -62,6 +65,7 @@ class PartResult:
     fit: ProfileFit | None = None
     flank_fits: tuple[ProfileFit, ...] = ()
     gcode: GcodeProgram | None = None
+    wall_fit: BarrelWallFit | None = None
 
     @property
     def findings(self) -> tuple[Finding, ...]:

@@ -46,8 +46,9 @@ from camcad.errors import DesignError, ValueRuleError
 from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec, PlaneModel
 from camcad.fit.spec import FitSpec
+from camcad.geometry.barrel import RollerShape
 from camcad.geometry.cam import Cam
-from camcad.geometry.families import FAMILIES, FamilyOptions, family_of
+from camcad.geometry.families import FAMILIES, BarrelSpec, family_of
 from camcad.geometry.followers import (
     DEFAULT_FOLLOWER,
     FOLLOWER_TYPES,
@@ -1064,6 +1065,8 @@ def _check_follower(design: Design) -> None:
                 f"(allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
             )
     swing = max(_lift_profile(design.motion))  # the largest lift, in the kind's lift unit
+    if design.barrel is not None:
+        return  # a barrel's arm has its own checks (camcad.geometry.barrel_limits), not a plate's
     problem = fol.kind.check(fol, design.cam.base_radius, swing)
     if problem is not None:
         raise DesignError(*problem)
@@ -1083,13 +1086,68 @@ def _lift_profile(segments: tuple[SegmentSpec, ...]) -> list[float]:
     return out
 
 
+# issue 36: the keys of a barrel cam (camcad.geometry.families.barrel), refused on every other style
+_BARREL_RULES: dict[str, dict[str, _Rule]] = {
+    "cam": {
+        "barrel_radius": _Rule("float", required=True, check=_length),
+        "length": _Rule("float", required=True, check=_length),
+    },
+    "follower": {
+        "axial_position": _Rule("float", required=True, check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm")),
+        "roller_length": _Rule("float", required=True, check=_length),
+        "roller": _Rule("enum", enum=RollerShape),
+    },
+}
+_NOT_ON_A_BARREL = (
+    "cam.base_radius",
+    "cam.outer_radius",
+    "cam.keyway_width",
+    "cam.keyway_depth",
+    "follower.offset",
+)
+
+
+def _barrel_table(data: Mapping[str, Any]) -> tuple[Mapping[str, Any], BarrelSpec | None]:
+    """A barrel's keys taken out of ``[cam]`` and ``[follower]``, checked; the rest of the design.
+
+    On any other style a barrel key is refused, naming it; on a barrel the
+    plate's size keys are (its size is ``barrel_radius``, its base circle the
+    groove's bottom). The ``[cam]`` table gets ``base_radius`` = ``barrel_radius``
+    as a stand-in until the groove's depth is known (:func:`parse_design`).
+    """
+    cam = data.get("cam")
+    barrel = isinstance(cam, Mapping) and cam.get("style") == CamStyle.BARREL.value
+    values: dict[str, Any] = {}
+    rest: dict[str, Any] = dict(data)
+    for name, rules in _BARREL_RULES.items():
+        table = data.get(name, {})
+        if not isinstance(table, Mapping):
+            continue  # _section names the table
+        for key, rule in rules.items():
+            if key in table and not barrel:
+                raise DesignError(f"{name}.{key}", "applies to cam.style = 'barrel' only")
+            if key in table:
+                values[key] = _convert(f"{name}.{key}", rule, table[key])
+            elif barrel and rule.required:
+                raise DesignError(f"{name}.{key}", "is required for a barrel cam (cam.style = 'barrel')")
+        rest[name] = {k: v for k, v in table.items() if k not in rules}
+    if not barrel:
+        return data, None
+    for path in _NOT_ON_A_BARREL:
+        name, key = path.split(".")
+        if key in rest.get(name, {}):
+            raise DesignError(path, "does not apply to a barrel cam (its size is cam.barrel_radius)")
+    rest["cam"] = {**rest["cam"], "base_radius": values["barrel_radius"]}
+    return rest, BarrelSpec(**values)
+
+
 def _check_style(design: Design) -> None:
     """The cam family's own checks (a groove's blank); positive drive needs a roller follower."""
     cam, fol = design.cam, design.follower
     family = family_of(cam.style)
     if family.needs_roller and not fol.kind.two_sided:
         raise DesignError("cam.style", f"a {family.name} cam needs a roller follower, not {fol.kind.word}")
-    options = FamilyOptions(groove=design.groove, conjugate=design.conjugate, outer_radius=cam.outer_radius)
+    options = design.family_options()
     family.check(
         options, base_radius=cam.base_radius, roller_radius=fol.roller_radius, thickness=cam.thickness
     )
@@ -1352,9 +1410,14 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
             raise DesignError(_key(key), _suggest(key, allowed))
     if "cam" not in data:
         raise DesignError("cam", "the [cam] table is required")
+    data, barrel = _barrel_table(data)  # issue 36: a barrel's own keys, taken out of [cam] and [follower]
     specs: dict[str, Any] = {}
     for name, cls in _SPEC_CLASSES.items():
         specs[name] = cls(**_section(name, data.get(name, {})))
+    if barrel is not None:  # its base circle is the groove's bottom (the plate checks' size)
+        bottom = max(barrel.barrel_radius - specs["groove"].depth, MIN_BASE_RADIUS_MM)
+        specs["cam"] = dataclasses.replace(specs["cam"], base_radius=bottom)
+        specs["barrel"] = barrel
     if "tool_diameter" not in data.get("gcode", {}):  # a groove cam then gets a cutter that fits it
         specs["gcode"] = dataclasses.replace(specs["gcode"], choose_tool=True)
     if "fea" in data:  # present or not decides whether a build runs the FE check

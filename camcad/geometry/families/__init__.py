@@ -5,7 +5,10 @@ See :mod:`camcad.geometry.families.base` for what a family yields.
 
 from __future__ import annotations
 
+from camcad.geometry.families.barrel import BARREL
 from camcad.geometry.families.base import (
+    Barrel,
+    BarrelSpec,
     CamFamily,
     Drive,
     FamilyOptions,
@@ -22,6 +25,8 @@ from camcad.geometry.spec import CamStyle
 
 __all__ = [
     "FAMILIES",
+    "Barrel",
+    "BarrelSpec",
     "CamFamily",
     "Drive",
     "FamilyOptions",
@@ -37,6 +42,7 @@ FAMILIES: dict[CamStyle, CamFamily] = {
     CamStyle.PLATE: PLATE,
     CamStyle.GROOVE: GROOVE,
     CamStyle.CONJUGATE: CONJUGATE,
+    CamStyle.BARREL: BARREL,
 }
 """Each ``cam.style`` and its family."""
 
