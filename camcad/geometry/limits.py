@@ -372,7 +372,7 @@ def _pivot_clearance(cam: Cam, radius_max: Extreme) -> list[Finding]:
     (the design states none).
     """
     pivot = cam.kinematics.guide.pivot
-    if pivot is None:
+    if pivot is None or not cam.turns_about_axis:  # a developed barrel groove sweeps no disc
         return []
     d = math.hypot(*pivot)
     if d > radius_max.value:

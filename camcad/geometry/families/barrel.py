@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -68,6 +68,7 @@ class BarrelCam(Cam):
 
     barrel_follower: BarrelFollower
     barrel_options: BarrelOptions
+    turns_about_axis: ClassVar[bool] = False  # the developed groove slides past; it sweeps no disc
 
     def _pitch_line(self, phi: ArrayLike, side: Side) -> tuple[Any, CurveSample, FloatArray]:
         m = self.motion(phi, side=side)
