@@ -151,7 +151,9 @@ def _check_rows(summary: dict[str, Any], design: Any) -> list[tuple[str, str]]:
         ),
         (
             "follower jump",
-            "none (positive drive)" if {"groove", "second_plate"} & set(summary) else _fmt(dyn.get("jump")),
+            "none (positive drive)"
+            if {"groove", "second_plate", "barrel"} & set(summary)
+            else _fmt(dyn.get("jump")),
         ),
         (
             "fit control points",
@@ -237,6 +239,36 @@ def _vibration_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     return rows
 
 
+def _barrel_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+    """The rows a barrel cam adds to ``camcad check`` (issue 36): pressure angles, groove, slip, walls."""
+    barrel = summary.get("barrel")
+    if barrel is None:
+        return []
+    rows: list[tuple[str, str]] = []
+    for where in ("bottom", "pitch", "top"):
+        ext = barrel["pressure_angle_max"][where]
+        radius = barrel["stations_mm"][where]
+        rows.append(
+            (
+                f"pressure angle at {where}",
+                f"{ext['value_deg']:.2f}° at {ext['angle_deg']:.1f}° (radius {radius:g} mm)",
+            )
+        )
+    z = barrel["groove_z_mm"]
+    rows.append(
+        ("groove along the axis", f"{z['lowest']:.3f} to {z['highest']:.3f} mm (of {barrel['length_mm']:g})")
+    )
+    slip = barrel["slip"]
+    rows.append(
+        (
+            "roller slip",
+            f"{slip['across_max']['value_mm_per_rad']:.3f} mm/rad round it, "
+            f"{slip['along_max']['value_mm_per_rad']:.3f} mm/rad along it (× ω for mm/s)",
+        )
+    )
+    return rows
+
+
 def _positive_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     """The rows a groove or a conjugate pair adds to ``camcad check``: flanks, second plate, crossovers."""
     rows: list[tuple[str, str]] = []
@@ -316,6 +348,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     # check does not depend on the [gcode] options: it plans no toolpath (build does)
     analysis = analyse(design, strict=False, toolpath=False, fea=args.fea or design.fea is not None)
     rows = _check_rows(analysis.summary(), design) + _positive_rows(analysis.summary())
+    rows += _barrel_rows(analysis.summary())
     rows += _duty_rows(analysis.summary())
     rows += _vibration_rows(analysis.summary())
     if analysis.fea is not None:

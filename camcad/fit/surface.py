@@ -191,6 +191,9 @@ class BarrelWallFit:
             "tolerance_mm": self.tolerance,
             "max_error_mm": self.max_error,
             "certified": self.max_error <= self.tolerance,
+            "control_points": sum(
+                s.distinct_u * int(s.control_points.shape[1]) for s in (self.upper, self.lower)
+            ),
             "upper_wall": wall(self.upper, self.upper_certificate),
             "lower_wall": wall(self.lower, self.lower_certificate),
         }
