@@ -21,13 +21,13 @@ from __future__ import annotations
 import json
 import math
 import shutil
-import tomllib
 from functools import cache
 from pathlib import Path
 
 import ezdxf
 import numpy as np
 import pytest
+import tomllib
 
 from camcad.cli import main
 from camcad.design import load_design, parse_design
@@ -226,13 +226,28 @@ def _toml(data: dict) -> str:
 
 BAD = [
     ("groove deeper than the wall", "indexer", {"groove": {"depth": 55.0}}, "groove.depth"),
-    ("roller longer than the groove", "indexer", {"follower": {"roller_length": 18.0}}, "follower.roller_length"),
-    ("groove past the barrel's end", "indexer", {"follower": {"axial_position": 5.0}}, "follower.axial_position"),
+    (
+        "roller longer than the groove",
+        "indexer",
+        {"follower": {"roller_length": 18.0}},
+        "follower.roller_length",
+    ),
+    (
+        "groove past the barrel's end",
+        "indexer",
+        {"follower": {"axial_position": 5.0}},
+        "follower.axial_position",
+    ),
     ("arm that cannot reach", "arm", {"follower": {"arm_length": 90.0}}, "follower.arm_length"),
     ("no barrel radius", "indexer", {"cam": {"barrel_radius": None}}, "cam.barrel_radius"),
     ("a plate's base radius", "indexer", {"cam": {"base_radius": 40.0}}, "cam.base_radius"),
     ("an unknown roller", "indexer", {"follower": {"roller": "spherical"}}, "follower.roller"),
-    ("a flat face", "indexer", {"follower": {"type": "translating-flat", "roller_radius": None}}, "cam.style"),
+    (
+        "a flat face",
+        "indexer",
+        {"follower": {"type": "translating-flat", "roller_radius": None}},
+        "cam.style",
+    ),
 ]
 
 

@@ -1086,7 +1086,8 @@ def _lift_profile(segments: tuple[SegmentSpec, ...]) -> list[float]:
     return out
 
 
-# issue 36: the keys of a barrel cam (camcad.geometry.families.barrel), refused on every other style
+# issue 36: the keys of a barrel cam, those its family owns (camcad.geometry.families.barrel: own_keys),
+# refused on every other style
 _BARREL_RULES: dict[str, dict[str, _Rule]] = {
     "cam": {
         "barrel_radius": _Rule("float", required=True, check=_length),
@@ -1116,7 +1117,10 @@ def _barrel_table(data: Mapping[str, Any]) -> tuple[Mapping[str, Any], BarrelSpe
     as a stand-in until the groove's depth is known (:func:`parse_design`).
     """
     cam = data.get("cam")
-    barrel = isinstance(cam, Mapping) and cam.get("style") == CamStyle.BARREL.value
+    word = cam.get("style", CamStyle.PLATE.value) if isinstance(cam, Mapping) else None
+    style = next((s for s in CamStyle if s.value == word), None)  # a bad word: _section names it
+    own = family_of(style).own_keys if style is not None else frozenset()
+    barrel = {f"{name}.{key}" for name, rules in _BARREL_RULES.items() for key in rules} <= own
     values: dict[str, Any] = {}
     rest: dict[str, Any] = dict(data)
     for name, rules in _BARREL_RULES.items():

@@ -172,6 +172,15 @@ class BarrelFamily:
 
     name = "barrel"
     table = "groove"  # the groove's depth and clearance, as a groove cam's
+    own_keys = frozenset(
+        {
+            "cam.barrel_radius",
+            "cam.length",
+            "follower.axial_position",
+            "follower.roller_length",
+            "follower.roller",
+        }
+    )
     needs_roller = True
     one_plate = False
 

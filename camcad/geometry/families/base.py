@@ -250,6 +250,11 @@ class CamFamily(Protocol):
         ...
 
     @property
+    def own_keys(self) -> frozenset[str]:
+        """The design keys only this family reads (``cam.barrel_radius``); refused on other styles."""
+        ...
+
+    @property
     def needs_roller(self) -> bool:
         """Whether the family drives its follower through a roller (positive drive does)."""
         ...
