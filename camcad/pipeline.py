@@ -252,7 +252,6 @@ def analyse(
     if toolpath and not hard:
         from camcad.export.gcode import render_program
         from camcad.export.gcode.rotary import render_rotary_program
-        from camcad.toolpath.barrel import BarrelToolpath
         from camcad.toolpath.parts import plan_part
 
         rotary = design.gcode.machine is Machine.ROTARY  # X + A/C in inverse time (camcad.toolpath.rotary)
@@ -280,9 +279,11 @@ def analyse(
             spent += timings.pop("toolpath", 0.0)
             if plan is None:
                 break
-            if isinstance(plan, BarrelToolpath):  # the 4-axis program of a barrel's groove
+            if result.part.barrel is not None:  # the 4-axis program of a barrel's groove (scipy: here only)
                 from camcad.export.gcode.barrel_program import barrel_program
+                from camcad.toolpath.barrel import BarrelToolpath
 
+                assert isinstance(plan, BarrelToolpath)
                 results[index] = replace(result, gcode=barrel_program(plan, name=design.cam.name))
                 continue
             if index == 0:

@@ -241,6 +241,7 @@ BAD = [
     ("arm that cannot reach", "arm", {"follower": {"arm_length": 90.0}}, "follower.arm_length"),
     ("no barrel radius", "indexer", {"cam": {"barrel_radius": None}}, "cam.barrel_radius"),
     ("a plate's base radius", "indexer", {"cam": {"base_radius": 40.0}}, "cam.base_radius"),
+    ("a plate's rotation", "indexer", {"cam": {"rotation": "cw"}}, "cam.rotation"),
     ("an unknown roller", "indexer", {"follower": {"roller": "spherical"}}, "follower.roller"),
     (
         "a flat face",

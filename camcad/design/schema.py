@@ -1099,13 +1099,16 @@ _BARREL_RULES: dict[str, dict[str, _Rule]] = {
         "roller": _Rule("enum", enum=RollerShape),
     },
 }
-_NOT_ON_A_BARREL = (
-    "cam.base_radius",
-    "cam.outer_radius",
-    "cam.keyway_width",
-    "cam.keyway_depth",
-    "follower.offset",
-)
+_SIZE = "its size is cam.barrel_radius and cam.length"
+_NOT_ON_A_BARREL = {  # a plate's keys, and why a barrel has none
+    "cam.base_radius": _SIZE,
+    "cam.outer_radius": _SIZE,
+    "cam.thickness": _SIZE,
+    "cam.rotation": "it turns one way in its own frame, φ running with the motion",
+    "cam.keyway_width": "its bore has no keyway",
+    "cam.keyway_depth": "its bore has no keyway",
+    "follower.offset": "its roller's axis is radial (give axial_position)",
+}
 
 
 def _barrel_table(data: Mapping[str, Any]) -> tuple[Mapping[str, Any], BarrelSpec | None]:
@@ -1137,10 +1140,10 @@ def _barrel_table(data: Mapping[str, Any]) -> tuple[Mapping[str, Any], BarrelSpe
         rest[name] = {k: v for k, v in table.items() if k not in rules}
     if not barrel:
         return data, None
-    for path in _NOT_ON_A_BARREL:
+    for path, why in _NOT_ON_A_BARREL.items():
         name, key = path.split(".")
         if key in rest.get(name, {}):
-            raise DesignError(path, "does not apply to a barrel cam (its size is cam.barrel_radius)")
+            raise DesignError(path, f"does not apply to a barrel cam ({why})")
     rest["cam"] = {**rest["cam"], "base_radius": values["barrel_radius"]}
     return rest, BarrelSpec(**values)
 

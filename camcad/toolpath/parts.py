@@ -12,14 +12,17 @@ or a rotary table (:func:`camcad.toolpath.rotary.plan_rotary`).
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from camcad.errors import DesignError
 from camcad.geometry.families import Barrel, Part
-from camcad.toolpath.barrel import BarrelToolpath, BarrelToolpathOptions, plan_barrel
 from camcad.toolpath.groove import plan_groove
 from camcad.toolpath.plan import Toolpath, plan_toolpath
 from camcad.toolpath.rotary import RotaryToolpath, plan_rotary
 from camcad.toolpath.spec import GcodeSpec, Machine
+
+if TYPE_CHECKING:  # its module loads scipy: imported where a barrel is planned
+    from camcad.toolpath.barrel import BarrelToolpath, BarrelToolpathOptions
 
 __all__ = ["barrel_toolpath_options", "plan_part"]
 
@@ -39,6 +42,8 @@ def barrel_toolpath_options(barrel: Barrel, spec: GcodeSpec) -> BarrelToolpathOp
     DesignError
         ``gcode.tool_diameter`` does not fit the groove with the stock on both walls.
     """
+    from camcad.toolpath.barrel import BarrelToolpathOptions
+
     o = barrel.options
     room = 2.0 * (o.roller_radius + 0.5 * o.clearance - spec.stock_to_leave)  # mm, the widest rougher
     if spec.choose_tool:
@@ -75,6 +80,8 @@ def plan_part(
     """
     title = part.title(name)
     if part.barrel is not None:
+        from camcad.toolpath.barrel import plan_barrel
+
         b = part.barrel
         return plan_barrel(b.program, b.follower, b.options, barrel_toolpath_options(b, spec))
     if part.pocket is not None:
