@@ -308,3 +308,29 @@ def test_the_samples_are_the_issues_cases():
     assert indexer.barrel.axial_position == 30.0 and arm.follower.arm_length == 110.0
     assert CASES["indexer"].program.lift == pytest.approx(40.0)
     assert CASES["arm"].program.lift == pytest.approx(12.0)
+
+
+def test_an_arm_that_runs_the_groove_backwards_is_refused_as_crossing_itself(tmp_path, capsys):
+    """A 20° swing over 20°: the developed groove at the bottom runs backwards, so it crosses itself.
+
+    Independent check: the roller's axis sits at y = d + l·cos(b0 − ψ) across the barrel
+    (b0 from the arm's triangle at rest), so the developed bottom line u = r_b·φ + y(φ) runs
+    backwards where du/dφ < 0, computed here from the poly-345 law's closed form.
+    """
+    data = _edited("arm")
+    for i, span in ((0, 20.0), (1, 160.0), (2, 20.0), (3, 160.0)):
+        data["motion"][i]["angle"] = span
+        if "lift" in data["motion"][i]:
+            data["motion"][i]["lift"] = 20.0
+    d, arm, bottom = 100.0, 110.0, 70.0 - 20.0
+    b0 = math.atan2(math.sqrt(arm * arm - d * d), -d)
+    phi = np.linspace(180.0, 200.0, 20_001)  # the return, degrees
+    x = (phi - 180.0) / 20.0
+    psi = math.radians(20.0) * (1.0 - (10 * x**3 - 15 * x**4 + 6 * x**5))  # poly-345 return
+    u = bottom * np.radians(phi) + d + arm * np.cos(b0 - psi)
+    assert np.diff(u).min() < 0.0  # the developed groove runs backwards: it crosses itself
+    path = tmp_path / "cross.toml"
+    path.write_text(_toml(data), encoding="utf-8")
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "follower.arm_length" in err and "crosses itself" in err
