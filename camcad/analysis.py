@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from camcad.dynamics.vibration import VibrationResult
     from camcad.export.gcode import GcodeProgram
     from camcad.fea.results import FeaResult  # only typing: the FE package loads when the check runs
+    from camcad.fit.surface import BarrelWallFit
     from camcad.toolpath import Toolpath
 
 __all__ = ["Analysis", "PartResult", "motion_summary"]
@@ -60,6 +61,8 @@ class PartResult:
     fea
         The finite-element check of a made plate (its own roller's contact
         loads); None when not run, or for a part that is not a plate.
+    wall_fit
+        A barrel's certified wall surfaces (:class:`~camcad.fit.surface.BarrelWallFit`), else None.
     """
 
     part: Part
@@ -70,6 +73,7 @@ class PartResult:
     gcode: GcodeProgram | None = None
     duty: DutyResult | None = None
     fea: FeaResult | None = None
+    wall_fit: BarrelWallFit | None = None
 
     @property
     def findings(self) -> tuple[Finding, ...]:

@@ -242,6 +242,11 @@ def analyse(
             if not result.part.made:
                 return result
             part = result.part
+            if part.barrel is not None:  # a barrel's groove walls: certified surfaces
+                from camcad.fit.surface import WallFitOptions, fit_barrel_walls
+
+                b, options = part.barrel, WallFitOptions(tolerance=design.fit.tolerance)
+                return replace(result, wall_fit=fit_barrel_walls(b.program, b.follower, b.options, options))
             flanks = tuple(fit_curve(part.cam, offset=f.offset) for f in part.flanks)
             return replace(result, fit=fit_curve(part.cam), flank_fits=flanks)
 
@@ -287,6 +292,13 @@ def analyse(
             spent += timings.pop("toolpath", 0.0)
             if plan is None:
                 break
+            if result.part.barrel is not None:  # the 4-axis program of a barrel's groove (scipy: here only)
+                from camcad.export.gcode.barrel_program import barrel_program
+                from camcad.toolpath.barrel import BarrelToolpath
+
+                assert isinstance(plan, BarrelToolpath)
+                results[index] = replace(result, gcode=barrel_program(plan, name=design.cam.name))
+                continue
             if index == 0:
                 planned = None if rotary else plan  # the rotary plan lives in its program (G93 text, figures)
             results[index] = replace(result, gcode=render(plan, design.gcode.dialect))
@@ -593,8 +605,14 @@ def _write_files(
     if "tables" in groups:
         stage("tables", lambda: write_tables(analysis, folder))
     made = [r for r in analysis.parts if r.part.made]  # a constant-breadth pair's second roller: no files
-    numbers = range(1, len(made) + 1) if len(made) > 1 else (0,)  # several parts: named 1, 2, … as mounted
-    if "dxf" in groups:
+    barrels = [r for r in made if r.part.barrel is not None]  # a barrel's files come from its walls
+    made = [r for r in made if r.part.barrel is None]
+    numbers = (
+        range(1, len(made) + 1) if len(made) > 1 else (0,) * len(made)
+    )  # several parts: named 1, 2, … as mounted
+    if barrels:
+        stage("barrel", lambda: _write_barrel_files(analysis, barrels, folder, groups=groups))
+    if "dxf" in groups and made:
         from camcad.export.dxf import write_part_dxfs
 
         stage(
@@ -607,7 +625,7 @@ def _write_files(
                 )
             ],
         )
-    if "stl" in groups:
+    if "stl" in groups and made:
         from camcad.export.mesh import write_part_meshes
 
         mesh = design.mesh
@@ -627,7 +645,7 @@ def _write_files(
                 )
             ],
         )
-    if "step" in groups:
+    if "step" in groups and made:
         from camcad.export.step import write_part_step
 
         stage(
@@ -641,13 +659,34 @@ def _write_files(
         )
     if "gcode" in groups:
         assert analysis.gcode is not None  # analysed with the toolpath when G-code is asked for
-        programs = [(f"cam{r.part.suffix}.ngc", r.gcode.text) for r in made if r.gcode is not None]
+        programs = [
+            (f"cam{r.part.suffix}.ngc", r.gcode.text) for r in (*barrels, *made) if r.gcode is not None
+        ]
         stage("gcode", lambda: [write_text(folder / name, text) for name, text in programs])
     if "fea" in groups and analysis.fea is not None:
         from camcad.export.stress import write_stress_vtu
 
         checked = [(r.part.suffix, r.fea) for r in made if r.fea is not None]  # every made plate's
         stage("stress", lambda: [write_stress_vtu(folder / f"stress{sfx}.vtu", f) for sfx, f in checked])
+    return written
+
+
+def _write_barrel_files(
+    analysis: Analysis, results: Sequence[PartResult], folder: Path, *, groups: set[str]
+) -> list[Path]:
+    """A barrel's developed groove (``profile.dxf``), ``cam.stl`` and ``cam.step``, as selected."""
+    from camcad.export.barrel_files import write_barrel_dxf, write_barrel_step, write_barrel_stl
+
+    design = analysis.design
+    written: list[Path] = []
+    for r in results:
+        if "dxf" in groups:
+            written.append(write_barrel_dxf(folder, r.part, tolerance=design.fit.tolerance))
+        if "stl" in groups:
+            written.append(write_barrel_stl(folder, r.part, chord=design.mesh.chord_tolerance))
+        if "step" in groups:
+            assert r.wall_fit is not None  # build always fits, and fails on walls it cannot certify
+            written.append(write_barrel_step(folder, r.part, fit=r.wall_fit, name=design.cam.name))
     return written
 
 

@@ -69,7 +69,7 @@ KNOWN_CYCLES: dict[tuple[str, ...], str] = {}
 # reason; the list only shrinks (an entry whose branch is gone fails too). It is empty.
 FAMILY_HOME = PACKAGE / "geometry" / "families"
 FAMILY_BRANCH = re.compile(
-    r"CamStyle\.(?:GROOVE|CONJUGATE)\b"  # a family named by its enum member (PLATE is the default)
+    r"CamStyle\.(?:GROOVE|CONJUGATE|BARREL)\b"  # a family named by its enum member (PLATE is the default)
     r"|(?:\bis|==|!=)\s*(?:not\s+)?CamStyle\.PLATE\b"
     r"|\.style\s+(?:is|==|!=)"  # a family told apart by comparing the style
     r"|\.style\.value\s*(?:==|!=)"

@@ -56,4 +56,10 @@ def design_plots(analysis: Analysis) -> list[Plot]:
 def report_plots(analysis: Analysis) -> list[Plot]:
     """Every figure of the single-design report, in display order (the shop's pictures last)."""
     shop = [fit_error_plot(analysis), toolpath_plot(analysis), solid_plot(analysis)]
-    return [*design_plots(analysis), *(p for p in shop if p is not None)]
+    plots = [*design_plots(analysis), *(p for p in shop if p is not None)]
+    if analysis.parts[0].part.barrel is not None:  # a barrel's shape: its own drawing and pictures
+        from camcad._plots.barrel import barrel_plots
+
+        plate = {"profile", "solid"}  # a plate's outline and its extruded solid: not a barrel's
+        return [*barrel_plots(analysis), *(p for p in plots if p.key not in plate)]
+    return plots

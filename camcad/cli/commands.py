@@ -10,7 +10,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from camcad._version import __version__
-from camcad.cli.render import _check_rows, _duty_rows, _fea_rows, _fmt, _positive_rows, _vibration_rows
+from camcad.cli.render import (
+    _barrel_rows,
+    _check_rows,
+    _duty_rows,
+    _fea_rows,
+    _fmt,
+    _positive_rows,
+    _vibration_rows,
+)
 from camcad.errors import (
     EXIT_LIMIT,
     EXIT_OK,
@@ -66,6 +74,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     positive = analysis.dynamics.positive_drive  # the family holds the follower on both ways (its Drive)
     rows = _check_rows(analysis.summary(), design, positive_drive=positive)
     rows += _positive_rows(analysis.summary(), positive_drive=positive)
+    rows += _barrel_rows(analysis.summary())
     rows += _duty_rows(analysis.summary())
     for later in analysis.parts[1:]:  # every further part's life and film (its own roller), the same rows
         if later.duty is not None:

@@ -173,6 +173,36 @@ def _vibration_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     return rows
 
 
+def _barrel_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+    """The rows a barrel cam adds to ``camcad check`` (issue 36): pressure angles, groove, slip, walls."""
+    barrel = summary.get("barrel")
+    if barrel is None:
+        return []
+    rows: list[tuple[str, str]] = []
+    for where in ("bottom", "pitch", "top"):
+        ext = barrel["pressure_angle_max"][where]
+        radius = barrel["stations_mm"][where]
+        rows.append(
+            (
+                f"pressure angle at {where}",
+                f"{ext['value_deg']:.2f}° at {ext['angle_deg']:.1f}° (radius {radius:g} mm)",
+            )
+        )
+    z = barrel["groove_z_mm"]
+    rows.append(
+        ("groove along the axis", f"{z['lowest']:.3f} to {z['highest']:.3f} mm (of {barrel['length_mm']:g})")
+    )
+    slip = barrel["slip"]
+    rows.append(
+        (
+            "roller slip",
+            f"{slip['across_max']['value_mm_per_rad']:.3f} mm/rad round it, "
+            f"{slip['along_max']['value_mm_per_rad']:.3f} mm/rad along it (× ω for mm/s)",
+        )
+    )
+    return rows
+
+
 def _positive_rows(summary: dict[str, Any], *, positive_drive: bool) -> list[tuple[str, str]]:
     """The rows a groove or a conjugate pair adds to ``camcad check``: flanks, second plate, crossovers."""
     rows: list[tuple[str, str]] = []

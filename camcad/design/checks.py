@@ -108,6 +108,8 @@ def _check_follower(design: Design) -> None:
                 f"(allowed: {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
             )
     swing = max(_lift_profile(design.motion))  # the largest lift, in the kind's lift unit
+    if design.barrel is not None:
+        return  # a barrel's arm has its own checks (camcad.geometry.barrel_limits), not a plate's
     problem = fol.kind.check(fol, design.cam.base_radius, swing)
     if problem is not None:
         raise DesignError(*problem)

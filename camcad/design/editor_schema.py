@@ -22,6 +22,7 @@ from typing import Any
 
 from camcad.design.rules import _Rule
 from camcad.design.tables import (  # the loader's rules, read only
+    _BARREL_RULES,
     _BOUNDARY_RULE,
     _LAW_RULES,
     _MOTION_RULES,
@@ -136,7 +137,9 @@ def design_json_schema() -> dict[str, Any]:
     properties: dict[str, Any] = {}
     for section, rules in _SECTIONS.items():
         props = {key: rule_schema(rule) for key, rule in rules.items()}
-        required = [key for key, rule in rules.items() if rule.required]
+        props |= {key: rule_schema(rule) for key, rule in _BARREL_RULES.get(section, {}).items()}
+        # a barrel's size is its barrel_radius: base_radius is required on the other styles only
+        required = [key for key, rule in rules.items() if rule.required and key != "base_radius"]
         table: dict[str, Any] = {"type": "object", "properties": props, "additionalProperties": False}
         if required:
             table["required"] = required
@@ -152,4 +155,25 @@ def design_json_schema() -> dict[str, Any]:
         "properties": properties,
         "required": ["cam", "motion"],
         "additionalProperties": False,
+        "allOf": [_barrel_keys()],
     }
+
+
+def _barrel_keys() -> dict[str, Any]:
+    """A barrel's keys required on ``style = "barrel"`` and refused on every other style (issue 36)."""
+    barrel = {"properties": {"cam": {"properties": {"style": {"const": "barrel"}}, "required": ["style"]}}}
+
+    def keys(required: bool) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for section, rules in _BARREL_RULES.items():
+            if required:
+                out[section] = {"required": [k for k, rule in rules.items() if rule.required]}
+            else:
+                out[section] = {"properties": dict.fromkeys(rules, False)}
+        return out
+
+    then = keys(True)
+    then["cam"]["properties"] = {"base_radius": False}
+    otherwise = keys(False)
+    otherwise["cam"]["required"] = ["base_radius"]
+    return {"if": barrel, "then": {"properties": then}, "else": {"properties": otherwise}}

@@ -36,9 +36,9 @@ from typing import TYPE_CHECKING, Any
 
 from camcad.design.checks import _check_design, _check_follower_keys
 from camcad.design.motion import _finish_motion, _segment
-from camcad.design.rules import MAX_SEGMENTS, _key, _suggest
+from camcad.design.rules import MAX_SEGMENTS, MIN_BASE_RADIUS_MM, _convert, _key, _suggest
 from camcad.design.spec import DEG, Design
-from camcad.design.tables import _SECTIONS, _SPEC_CLASSES, _TOLERANCED, _section
+from camcad.design.tables import _BARREL_RULES, _SECTIONS, _SPEC_CLASSES, _TOLERANCED, _section
 from camcad.design.toml_where import _MAX_DIGITS, MAX_NESTING, _find_value, _nesting
 from camcad.dynamics.drive import DriveSpec
 from camcad.dynamics.film import LubricationSpec
@@ -47,7 +47,8 @@ from camcad.dynamics.vibration.spec import VibrationSpec
 from camcad.errors import DesignError
 from camcad.fea.spec import FeaSpec
 from camcad.geometry.cam import Cam
-from camcad.geometry.families import FAMILIES, family_of
+from camcad.geometry.families import FAMILIES, BarrelSpec, family_of
+from camcad.geometry.spec import CamStyle
 from camcad.geometry.sensitivity import Tol
 
 if TYPE_CHECKING:
@@ -94,6 +95,55 @@ def _service_tables(data: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+_SIZE = "its size is cam.barrel_radius and cam.length"
+_NOT_ON_A_BARREL = {  # a plate's keys, and why a barrel has none
+    "cam.base_radius": _SIZE,
+    "cam.outer_radius": _SIZE,
+    "cam.thickness": _SIZE,
+    "cam.rotation": "it turns one way in its own frame, φ running with the motion",
+    "cam.keyway_width": "its bore has no keyway",
+    "cam.keyway_depth": "its bore has no keyway",
+    "follower.offset": "its roller's axis is radial (give axial_position)",
+}
+
+
+def _barrel_table(data: Mapping[str, Any]) -> tuple[Mapping[str, Any], BarrelSpec | None]:
+    """A barrel's keys taken out of ``[cam]`` and ``[follower]``, checked; the rest of the design.
+
+    On any other style a barrel key is refused, naming it; on a barrel the
+    plate's size keys are (its size is ``barrel_radius``, its base circle the
+    groove's bottom). The ``[cam]`` table gets ``base_radius`` = ``barrel_radius``
+    as a stand-in until the groove's depth is known (:func:`parse_design`).
+    """
+    cam = data.get("cam")
+    word = cam.get("style", CamStyle.PLATE.value) if isinstance(cam, Mapping) else None
+    style = next((s for s in CamStyle if s.value == word), None)  # a bad word: _section names it
+    own = family_of(style).own_keys if style is not None else frozenset()
+    barrel = {f"{name}.{key}" for name, rules in _BARREL_RULES.items() for key in rules} <= own
+    values: dict[str, Any] = {}
+    rest: dict[str, Any] = dict(data)
+    for name, rules in _BARREL_RULES.items():
+        table = data.get(name, {})
+        if not isinstance(table, Mapping):
+            continue  # _section names the table
+        for key, rule in rules.items():
+            if key in table and not barrel:
+                raise DesignError(f"{name}.{key}", "applies to cam.style = 'barrel' only")
+            if key in table:
+                values[key] = _convert(f"{name}.{key}", rule, table[key])
+            elif barrel and rule.required:
+                raise DesignError(f"{name}.{key}", "is required for a barrel cam (cam.style = 'barrel')")
+        rest[name] = {k: v for k, v in table.items() if k not in rules}
+    if not barrel:
+        return data, None
+    for path, why in _NOT_ON_A_BARREL.items():
+        name, key = path.split(".")
+        if key in rest.get(name, {}):
+            raise DesignError(path, f"does not apply to a barrel cam ({why})")
+    rest["cam"] = {**rest["cam"], "base_radius": values["barrel_radius"]}
+    return rest, BarrelSpec(**values)
+
+
 def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path | None = None) -> Design:
     """Validate a design given as a TOML-like mapping.
 
@@ -113,9 +163,14 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
             raise DesignError(_key(key), _suggest(key, allowed))
     if "cam" not in data:
         raise DesignError("cam", "the [cam] table is required")
+    data, barrel = _barrel_table(data)  # issue 36: a barrel's own keys, taken out of [cam] and [follower]
     specs: dict[str, Any] = {}
     for name, cls in _SPEC_CLASSES.items():
         specs[name] = cls(**_section(name, data.get(name, {})))
+    if barrel is not None:  # its base circle is the groove's bottom (the plate checks' size)
+        bottom = max(barrel.barrel_radius - specs["groove"].depth, MIN_BASE_RADIUS_MM)
+        specs["cam"] = dataclasses.replace(specs["cam"], base_radius=bottom)
+        specs["barrel"] = barrel
     if "tool_diameter" not in data.get("gcode", {}):  # a groove cam then gets a cutter that fits it
         specs["gcode"] = dataclasses.replace(specs["gcode"], choose_tool=True)
     if "fea" in data:  # present or not decides whether a build runs the FE check

@@ -23,7 +23,7 @@ from camcad.export.spec import DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import FeaSpec
 from camcad.fit.spec import FitSpec
 from camcad.geometry.cam import follower_from_spec
-from camcad.geometry.families import FamilyOptions, family_of
+from camcad.geometry.families import BarrelSpec, FamilyOptions, family_of
 from camcad.geometry.plate import BoreOutline, Plate
 from camcad.geometry.spec import CamStyle, ConjugateSpec, FollowerSpec, GrooveSpec, LinearSpec, Rotation
 from camcad.motion.segments import SegmentSpec
@@ -79,6 +79,7 @@ class Design:
     lubrication: LubricationSpec | None = None
     drive: DriveSpec | None = None
     vibration: VibrationSpec | None = None  # [vibration] (issue 34): None when absent
+    barrel: BarrelSpec | None = None  # a barrel cam's own keys (issue 36): None for every other style
     source: str = ""
 
     def plate(self) -> Plate:
@@ -99,17 +100,21 @@ class Design:
             linear=self.linear,
             outer_radius=self.cam.outer_radius,
             hole_radius=0.0 if bore is None else bore.reach,
+            barrel=self.barrel,
+            bore=self.cam.bore,
         )
 
     def dynamics_setup(self) -> DynamicsSetup:
         """The dynamics stage's options: ``[dynamics]`` with the speed and contact geometry it uses."""
         dyn, cam, fol = self.dynamics, self.cam, self.follower
         module = follower_from_spec(fol, cam.base_radius)
+        # the line contact's length: the roller's on a barrel, else the plate's thickness
+        length = cam.thickness if self.barrel is None else self.barrel.roller_length
         return DynamicsSetup(
             spec=dyn,
             omega=cam.omega,
             base_radius=cam.base_radius,
-            contact_length=dyn.contact_width if dyn.contact_width is not None else cam.thickness,
+            contact_length=dyn.contact_width if dyn.contact_width is not None else length,
             roller_radius=module.contact_radius,  # the radius that sets the contact stress; 0: flat
             # Hren et al.'s Fig. 2 is a ccw cam; a cw cam is its mirror image, follower at −e
             tappet_offset=fol.eccentricity if cam.rotation is Rotation.CCW else -fol.eccentricity,

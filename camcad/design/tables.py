@@ -56,6 +56,7 @@ from camcad.errors import DesignError
 from camcad.export.spec import DriveLayout, DxfSpec, MeshSpec, TablesSpec
 from camcad.fea.spec import PlaneModel
 from camcad.fit.spec import FitSpec
+from camcad.geometry.barrel import RollerShape
 from camcad.geometry.followers import (
     DEFAULT_FOLLOWER,
     FOLLOWER_TYPES,
@@ -478,3 +479,18 @@ def _section(name: str, table: Any) -> dict[str, Any]:
         elif rule.required:
             raise DesignError(f"{name}.{key}", "is required")
     return kwargs
+
+
+# issue 36: the keys of a barrel cam, those its family owns (camcad.geometry.families.barrel: own_keys),
+# refused on every other style
+_BARREL_RULES: dict[str, dict[str, _Rule]] = {
+    "cam": {
+        "barrel_radius": _Rule("float", required=True, check=_length),
+        "length": _Rule("float", required=True, check=_length),
+    },
+    "follower": {
+        "axial_position": _Rule("float", required=True, check=_between(-MAX_LENGTH_MM, MAX_LENGTH_MM, " mm")),
+        "roller_length": _Rule("float", required=True, check=_length),
+        "roller": _Rule("enum", enum=RollerShape),
+    },
+}

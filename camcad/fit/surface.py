@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -171,6 +172,31 @@ class BarrelWallFit:
     def max_error(self) -> float:
         """The larger certified error of the two walls [mm]."""
         return max(self.upper_certificate.max_error, self.lower_certificate.max_error)
+
+    def summary(self) -> dict[str, Any]:
+        """The ``fit`` section of a barrel's summary.json: each wall's surface and its certificate [mm]."""
+
+        def wall(surface: BSplineSurface, cert: SurfaceCertificate) -> dict[str, Any]:
+            return {
+                "control_points": [surface.distinct_u, int(surface.control_points.shape[1])],
+                "degree": [surface.degree_u, surface.degree_v],
+                "stations_mm": list(surface.station_range),
+                "max_error_mm": cert.max_error,
+                "node_max_error_mm": cert.node_max,
+                "check_grid": list(cert.grid),
+            }
+
+        return {
+            "kind": "barrel walls (bicubic B-spline surfaces, periodic round the barrel)",
+            "tolerance_mm": self.tolerance,
+            "max_error_mm": self.max_error,
+            "certified": self.max_error <= self.tolerance,
+            "control_points": sum(
+                s.distinct_u * int(s.control_points.shape[1]) for s in (self.upper, self.lower)
+            ),
+            "upper_wall": wall(self.upper, self.upper_certificate),
+            "lower_wall": wall(self.lower, self.lower_certificate),
+        }
 
 
 def wall_station_range(

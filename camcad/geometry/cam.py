@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Protocol
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
@@ -141,6 +141,7 @@ class Cam:
     sample_step: float = math.radians(0.1)
     conjugate: ConjugateSpec | None = None  # set: this is the pair's second plate, driving the tied roller
     stroke_length: float | None = None  # set: a linear cam, L [mm] of plate travel per cycle
+    turns_about_axis: ClassVar[bool] = True  # its profile turns about the cam axis (a developed groove: no)
     _memo: dict[str, Any] = field(  # the follower module, and the last sample grid's motion and state
         default_factory=dict, init=False, compare=False, hash=False, repr=False
     )

@@ -361,7 +361,7 @@ def _pivot_clearance(cam: Cam, radius_max: Extreme) -> list[Finding]:
     (the design states none).
     """
     pivot = cam.follower.guide.pivot
-    if pivot is None:
+    if pivot is None or not cam.turns_about_axis:  # a developed barrel groove sweeps no disc
         return []
     if not cam.closed:
         return _pivot_above_bar(cam, pivot)

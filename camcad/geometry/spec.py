@@ -26,12 +26,13 @@ class Rotation(enum.Enum):
 
 
 class CamStyle(enum.Enum):
-    """How the cam drives the follower: a plate (a spring holds the follower on), a groove or a pair."""
+    """How the cam drives the follower: a plate (a spring holds it on), a groove, a pair, a barrel."""
 
     PLATE = "plate"
     GROOVE = "groove"
     CONJUGATE = "conjugate"
     LINEAR = "linear"
+    BARREL = "barrel"  # issue 36: a groove round a cylinder (camcad.geometry.families.barrel)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

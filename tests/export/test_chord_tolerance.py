@@ -25,7 +25,7 @@ from camcad.design import load_design
 from camcad.errors import DesignError
 from camcad.export._outline import chord_budget
 from camcad.pipeline import build
-from tests.conftest import SAMPLES, distance_to_polygon
+from tests.conftest import DISC_SAMPLES, SAMPLES, distance_to_polygon
 
 _DENSE = 100_000
 _SUB = np.linspace(0.0, 1.0, 9)  # points along each chord
@@ -74,7 +74,7 @@ def curves(name: str) -> dict[str, tuple[int, float]]:
     return {"CAM_PROFILE": (1, 0.0)}
 
 
-@pytest.mark.parametrize("name", [p.stem for p in SAMPLES])
+@pytest.mark.parametrize("name", [p.stem for p in DISC_SAMPLES])
 def test_polylines_and_stl_keep_within_chord_tolerance_of_the_exact_profile(name, folder):
     result = _build(name, folder)
     out = folder / name

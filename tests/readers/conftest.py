@@ -20,7 +20,7 @@ from camcad.export.dxf import write_profile_dxf, write_profile_poly_dxf
 from camcad.export.mesh import SolidResult, build_solid, write_meshes
 from camcad.fit import ProfileFit, fit_cam_profile
 from camcad.geometry.cam import Cam
-from tests.conftest import SAMPLES, make_design
+from tests.conftest import DISC_SAMPLES, make_design
 
 PROGRAM_TIMEOUT = 300  # s, per program run
 
@@ -54,7 +54,7 @@ def _fit(design: Design, cam: Cam) -> ProfileFit:
 
 
 def _cases() -> dict[str, object]:
-    cases: dict[str, object] = {p.stem: p for p in SAMPLES}
+    cases: dict[str, object] = {p.stem: p for p in DISC_SAMPLES}
     cases["keyed-bore"] = "keyed"
     return cases
 

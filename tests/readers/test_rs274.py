@@ -22,7 +22,7 @@ from camcad.design import Design, load_design
 from camcad.export.gcode import parse_canon, parse_gcode, render_gcode
 from camcad.geometry.cam import Cam
 from camcad.toolpath import Toolpath, check_toolpath, plan_toolpath
-from tests.conftest import SAMPLES, make_design
+from tests.conftest import DISC_SAMPLES, make_design
 
 RS274 = shutil.which("rs274")
 pytestmark = [
@@ -141,7 +141,7 @@ def planned_sample(path: Path) -> tuple[Design, Cam, Toolpath]:
 
 
 @pytest.mark.parametrize("dialect", DIALECTS)
-@pytest.mark.parametrize("path", SAMPLES, ids=[p.stem for p in SAMPLES])
+@pytest.mark.parametrize("path", DISC_SAMPLES, ids=[p.stem for p in DISC_SAMPLES])
 def test_rs274_runs_every_sample_in_every_dialect(path, dialect, tmp_path):
     design, cam, tp = planned_sample(path)
     text = render_gcode(tp, dialect)

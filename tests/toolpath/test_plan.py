@@ -22,7 +22,7 @@ from camcad.geometry.tool import check_tool
 from camcad.toolpath import MoveKind, Toolpath, check_toolpath, contour, plan_toolpath
 from camcad.toolpath.contour import Step, split_tabs
 from camcad.toolpath.verify import densify, distance_to_polyline
-from tests.conftest import SAMPLES, make_design
+from tests.conftest import DISC_SAMPLES, make_design
 
 CONFIGS = {
     "climb": {},
@@ -344,7 +344,7 @@ def test_g1_only_path_meets_the_same_tolerance_with_many_more_blocks():
     assert lines.contour_blocks > 5 * tp.contour_blocks
 
 
-@pytest.mark.parametrize("path", SAMPLES[:2], ids=[p.stem for p in SAMPLES[:2]])
+@pytest.mark.parametrize("path", DISC_SAMPLES[:2], ids=[p.stem for p in DISC_SAMPLES[:2]])
 def test_samples_plan_and_prove(path):
     design = load_design(path)
     cam = Cam.from_design(design)

@@ -5,8 +5,11 @@ See :mod:`camcad.geometry.families.base` for what a family yields.
 
 from __future__ import annotations
 
+from camcad.geometry.families.barrel import BARREL
 from camcad.geometry.families.base import (
     Bar,
+    Barrel,
+    BarrelSpec,
     CamFamily,
     Drive,
     FamilyOptions,
@@ -25,6 +28,8 @@ from camcad.geometry.spec import CamStyle
 __all__ = [
     "FAMILIES",
     "Bar",
+    "Barrel",
+    "BarrelSpec",
     "CamFamily",
     "Drive",
     "FamilyOptions",
@@ -41,6 +46,7 @@ FAMILIES: dict[CamStyle, CamFamily] = {
     CamStyle.GROOVE: GROOVE,
     CamStyle.CONJUGATE: CONJUGATE,
     CamStyle.LINEAR: LINEAR,
+    CamStyle.BARREL: BARREL,
 }
 """Each ``cam.style`` and its family."""
 

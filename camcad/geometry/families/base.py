@@ -12,8 +12,9 @@ stays in that family's module.
 
 The shape of a part is data the writers read, not a family name: a part
 with no :attr:`Part.pocket` is a plate cut along its outline; one with a
-:class:`Pocket` is a blank with a pocket between two flanks. A barrel cam
-adds its own shape (walls on a cylinder) here and its writers below.
+:class:`Pocket` is a blank with a pocket between two flanks; one with a
+:class:`Barrel` is a cylinder with a groove round it, whose walls the later
+stages take from its exact envelope (:mod:`camcad.geometry.barrel`).
 """
 
 from __future__ import annotations
@@ -23,11 +24,16 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol, TypedDict
 
 from camcad.findings import Finding
+from camcad.geometry.barrel import BarrelFollower, BarrelOptions, RollerShape
+from camcad.geometry.barrel_limits import BarrelLimits
 from camcad.geometry.cam import Cam
 from camcad.geometry.spec import ConjugateSpec, GrooveSpec, LinearSpec
+from camcad.motion.program import MotionProgram
 
 __all__ = [
     "Bar",
+    "Barrel",
+    "BarrelSpec",
     "CamFamily",
     "Drive",
     "FamilyOptions",
@@ -40,11 +46,28 @@ __all__ = [
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class BarrelSpec:
+    """What the design states of a barrel cam beyond the ``[groove]`` table (issue 36).
+
+    ``barrel_radius`` R [mm] (outer) and ``length`` [mm] along its axis
+    (``[cam]``); ``axial_position`` z0 [mm], the roller's axis at φ = 0,
+    ``roller`` its shape and ``roller_length`` ℓ [mm] (``[follower]``).
+    """
+
+    barrel_radius: float
+    length: float
+    axial_position: float
+    roller_length: float
+    roller: RollerShape = RollerShape.CYLINDRICAL
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FamilyOptions:
     """What the families read from the design: the ``[groove]`` and ``[conjugate]`` tables, the blank.
 
     ``outer_radius`` [mm]: a groove cam's blank (None: no blank);
-    ``hole_radius`` [mm]: the bore's farthest reach, keyway included (0 without a bore).
+    ``hole_radius`` [mm]: the bore's farthest reach, keyway included (0 without a bore);
+    ``barrel``: a barrel cam's :class:`BarrelSpec`; ``bore`` [mm]: the bore's diameter.
     """
 
     groove: GrooveSpec = field(default_factory=GrooveSpec)
@@ -52,6 +75,8 @@ class FamilyOptions:
     linear: LinearSpec = field(default_factory=LinearSpec)
     outer_radius: float | None = None
     hole_radius: float = 0.0
+    barrel: BarrelSpec | None = None  # a barrel cam's own values; None for every other style
+    bore: float = 0.0  # the bore's diameter [mm] (a barrel's; a plate's is in hole_radius)
 
 
 class Drive(TypedDict):
@@ -129,6 +154,21 @@ class Bar:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class Barrel:
+    """A cylinder with a groove round it: the exact walls' data (:mod:`camcad.geometry.barrel`).
+
+    ``program`` the motion, ``follower`` where it holds the roller's axis,
+    ``options`` the barrel, groove and roller [mm], ``limits`` its checked
+    figures over the turn (:func:`~camcad.geometry.barrel_limits.barrel_limits`).
+    """
+
+    program: MotionProgram
+    follower: BarrelFollower
+    options: BarrelOptions
+    limits: BarrelLimits
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Part:
     """One part a cam family makes, and what every later stage needs of it.
 
@@ -155,6 +195,10 @@ class Part:
     bar
         None: a disc. Else the bar whose top edge is the cam's open profile
         (a linear cam).
+    barrel
+        None, or the cylinder and its groove (a barrel cam): its fit, files
+        and tool path are taken from the walls, its ``cam`` is the groove
+        developed at the roller's pitch station.
     checks
         The family's own checks of the part (a groove's flank checks).
     """
@@ -166,6 +210,7 @@ class Part:
     made: bool = True
     pocket: Pocket | None = None
     bar: Bar | None = None
+    barrel: Barrel | None = None
     checks: tuple[PartCheck, ...] = ()
 
     @property
@@ -221,6 +266,11 @@ class PartResults(Protocol):
         """Its :class:`~camcad.dynamics.duty.DutyResult` (life and film: ``summary()``), or None."""
         ...
 
+    @property
+    def wall_fit(self) -> Any:
+        """A barrel's :class:`~camcad.fit.surface.BarrelWallFit`, or None."""
+        ...
+
 
 class CamFamily(Protocol):
     """A cam family: the parts it makes of a cam, its own ``summary.json`` section and caption."""
@@ -233,6 +283,11 @@ class CamFamily(Protocol):
     @property
     def table(self) -> str | None:
         """The TOML table only this family reads (``[groove]``, ``[conjugate]``), or None."""
+        ...
+
+    @property
+    def own_keys(self) -> frozenset[str]:
+        """The design keys only this family reads (``cam.barrel_radius``); refused on other styles."""
         ...
 
     @property

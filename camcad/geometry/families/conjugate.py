@@ -26,6 +26,7 @@ class ConjugateFamily:
 
     name = "conjugate"
     table = "conjugate"
+    own_keys: frozenset[str] = frozenset()
     needs_roller = True
     one_plate = False
     plates = True

@@ -26,6 +26,7 @@ class GrooveFamily:
 
     name = "groove"
     table = "groove"
+    own_keys: frozenset[str] = frozenset()
     needs_roller = True
     one_plate = False
     plates = False  # a blank with a pocket

@@ -17,6 +17,7 @@ class PlateFamily:
 
     name = "plate"
     table = None
+    own_keys: frozenset[str] = frozenset()
     needs_roller = False
     one_plate = True
     plates = True
