@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from camcad.analysis import Analysis, PartResult, motion_summary
 from camcad.design import Design, load_design
@@ -296,8 +296,8 @@ def analyse(
                 from camcad.export.gcode.barrel_program import barrel_program
                 from camcad.toolpath.barrel import BarrelToolpath
 
-                assert isinstance(plan, BarrelToolpath)
-                results[index] = replace(result, gcode=barrel_program(plan, name=design.cam.name))
+                program = barrel_program(cast(BarrelToolpath, plan), name=design.cam.name)  # plan_part's
+                results[index] = replace(result, gcode=program)
                 continue
             if index == 0:
                 planned = None if rotary else plan  # the rotary plan lives in its program (G93 text, figures)

@@ -48,8 +48,8 @@ from camcad.errors import DesignError
 from camcad.fea.spec import FeaSpec
 from camcad.geometry.cam import Cam
 from camcad.geometry.families import FAMILIES, BarrelSpec, family_of
-from camcad.geometry.spec import CamStyle
 from camcad.geometry.sensitivity import Tol
+from camcad.geometry.spec import CamStyle
 
 if TYPE_CHECKING:
     from camcad.inspect.spec import ToleranceSpec

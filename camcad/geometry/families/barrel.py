@@ -132,7 +132,7 @@ def _barrel_objects(cam: Cam, options: FamilyOptions) -> tuple[BarrelFollower, B
     spec = options.barrel
     if spec is None:
         raise DesignError("cam.barrel_radius", "is required for a barrel cam (mm, the barrel's outer radius)")
-    fol = cam.follower
+    fol = cam.follower_spec
     follower: BarrelFollower
     if fol.kind.lift.angular:  # an arm: its pivot axis perpendicular to the barrel's
         assert fol.pivot_distance is not None and fol.arm_length is not None  # the schema requires them
@@ -183,6 +183,7 @@ class BarrelFamily:
     )
     needs_roller = True
     one_plate = False
+    plates = False  # a cylinder: no FE check of a plate
 
     def check(
         self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
@@ -205,7 +206,7 @@ class BarrelFamily:
         developed = BarrelCam(
             program=cam.program,
             base_radius=cam.base_radius,
-            follower=cam.follower,
+            follower_spec=cam.follower_spec,
             rotation=cam.rotation,
             sample_step=cam.sample_step,
             barrel_follower=barrel.follower,
@@ -252,6 +253,11 @@ class _BarrelCheck:
     @property
     def findings(self) -> tuple[Any, ...]:
         return self.barrel.limits.findings
+
+    @property
+    def radius_margin(self) -> float:
+        """No flank radius to keep positive: a wall that loops (stretch λ ≤ 0) is its own hard finding."""
+        return math.inf
 
     def summary(self) -> dict[str, Any]:
         return _barrel_summary(self.barrel)

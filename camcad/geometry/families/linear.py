@@ -42,6 +42,7 @@ class LinearFamily:
 
     name = "linear"
     table = "linear"
+    own_keys: frozenset[str] = frozenset()  # its keys are the [linear] table's
     needs_roller = False  # a curved (mushroom) face works too; a flat face is refused in check_cam
     one_plate = False  # no rotary machine
     plates = False  # a bar, not a disc: no FE check of a plate
