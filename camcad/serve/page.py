@@ -110,7 +110,8 @@ details summary { cursor: pointer; color: var(--muted); font-size: 12.5px; margi
 .bar button { font: inherit; padding: 5px 12px; border-radius: 5px; border: 1px solid #1f5f9e;
               background: #1f5f9e; color: #fff; cursor: pointer; }
 .bar button.secondary { background: #fff; color: #1f5f9e; }
-#status { color: var(--muted); font-size: 12.5px; }
+#status { color: var(--muted); font-size: 12.5px; flex: 1 1 12em; min-width: 0; white-space: nowrap;
+          overflow: hidden; text-overflow: ellipsis; }
 #general-error:empty, #notice:empty { display: none; }
 body[data-state="invalid"] #cam-drawing, body[data-state="invalid"] .charts,
 body[data-state="invalid"] #cards, body[data-state="invalid"] #speed-range { opacity: 0.45; }

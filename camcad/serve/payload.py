@@ -76,20 +76,24 @@ def _shown(values: Any, clip: float | None = None) -> np.ndarray:
     return arr
 
 
-def decimate(columns: list[np.ndarray], buckets: int = CHART_BUCKETS) -> np.ndarray:
+def decimate(
+    columns: list[np.ndarray], buckets: int = CHART_BUCKETS, always: np.ndarray | None = None
+) -> np.ndarray:
     """Sample indices that keep every bucket's smallest and largest value of every column (min-max).
 
     The ``n`` samples are cut into ``buckets`` runs of equal length; of each
     run the samples holding each column's smallest and largest finite value
-    are kept, with the first and last sample and both ends of every gap (a
-    NaN run), so a line through the kept samples reaches every sampled
-    extreme and breaks where the curve does. Sorted, unique.
+    are kept, with the first and last sample, the indices ``always`` (the
+    segments' joints: the curve passes through every blend point) and both
+    ends of every gap (a NaN run), so a line through the kept samples
+    reaches every sampled extreme and breaks where the curve does. Sorted,
+    unique.
     """
     n = len(columns[0]) if columns else 0
     if n <= 2 * buckets:
         return np.arange(n)
     size = -(-n // buckets)
-    keep = [np.array([0, n - 1])]
+    keep = [np.array([0, n - 1]), np.zeros(0, dtype=int) if always is None else np.asarray(always, dtype=int)]
     for col in columns:
         finite = np.isfinite(col)
         pad = np.full(size * buckets, np.nan)
@@ -202,8 +206,11 @@ def _curves(analysis: Analysis) -> list[dict[str, Any]]:
         _chart("stress", "Hertz stress", "MPa", one("σ", dyn.hertz_stress), stress_limits),
     ]
     _second_plate_curves(analysis, charts)
+    grid = np.asarray(geo.phi, dtype=float)
+    marks = np.mod([bp.phi for bp in cam.program.breakpoints], 2.0 * math.pi)
+    joints = np.clip(np.searchsorted(grid, marks - 1e-9), 0, len(grid) - 1)  # the grid holds every joint
     for chart in charts:
-        index = decimate([y for _, y in chart["series"]])
+        index = decimate([y for _, y in chart["series"]], always=joints)
         chart["phi_deg"] = np.round(phi[index], 4).tolist()
         chart["series"] = [{"label": label, "y": _series(y, index)} for label, y in chart["series"]]
     points = _table_points(analysis)

@@ -400,6 +400,16 @@ def test_drag_a_blend_point_edits_angle_and_lift(browser, tmp_path):
         assert browser.execute_script("return +document.getElementById('chart-s').dataset.ymax") == (
             pytest.approx(lift, abs=1e-5)
         )
+        # the point where the dwell ends: its level moves with the rise before it and the return after it
+        _edited(browser, lambda: _drag_point(browser, 1, 250.0, lift - 6.0), "the dwell's end dragged")
+        motion = _motion_saved(browser, design)
+        lift2 = motion[0]["lift"]
+        assert lift2 == pytest.approx(lift - 6.0, abs=2 * pixel[0] + 0.01) and motion[2]["lift"] == lift2
+        assert motion[0]["angle"] == angle and motion[1]["angle"] + angle == pytest.approx(250.0, abs=1.0)
+        assert motion[1]["angle"] + motion[2]["angle"] == pytest.approx(360.0 - angle)
+        result = analyse(load_design(design), fit=False, toolpath=False)
+        assert float(np.max(result.motion.s)) == pytest.approx(lift2, abs=1e-9)
+        lift, angle = lift2, motion[0]["angle"]
 
         # below the base circle: the loader refuses, and the page says so under the field it names
         _edited(browser, lambda: _drag_point(browser, 0, angle, -12.0), "the refused drag")

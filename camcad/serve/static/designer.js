@@ -334,6 +334,7 @@ function drawChart(parent, chart, motion) {
     width: chartWidth(p.box), height: 200, series,
     scales: {x: {time: false, range: (u, a, b) => [a ?? 0, b ?? 360]},
              y: {range: (u, a, b) => {
+               if (p.frozenY) return p.frozenY;  // a blend point is being dragged: the scale holds still
                for (const l of p.chart.limits || []) { a = Math.min(a, l); b = Math.max(b, l); }
                const pad = (b - a) * 0.06 || 1; return [a - pad, b + pad]; }}},
     axes: [{values: (u, v) => v.map(x => x + "°")}, {size: 56}],
@@ -351,17 +352,21 @@ function drawBands() { for (const k of MOTION) if (plots[k] && plots[k].u) plots
 window.addEventListener("resize", () => { for (const p of Object.values(plots)) if (p.u) p.u.setSize({width: chartWidth(p.box), height: 200}); });
 
 // Blend points: the ends of the segments on the displacement chart, at (angle, lift). Dragging one moves
-// the boundary (as the line does) and, up or down, the lift there: the segment ending at it rises or falls
-// by as much more, and the next segment that moves the follower (not a dwell) by as much less, so the rest
-// of the program stays where it was ("close" closes by itself). The values go through the editor's fields
-// and the same analysis as typing them; a value the loader refuses shows its message under the field.
+// the boundary (as the line does) and, up or down, the lift there: the last rise or return up to it (the
+// segment itself, or the one before the dwells ending there) rises or falls by as much more, and the next
+// rise or return after it by as much less, so the rest of the program stays where it was ("close" closes
+// by itself). The values go through the editor's fields and the same analysis as typing them; a value the
+// loader refuses shows its message under the field.
 let blend = null;  // {k, x, y} while a blend point is dragged (drawn at the cursor until the answer comes)
 function liftSign(s) { return s.kind === "rise" ? 1 : s.kind === "return" ? -1 : 0; }
 function numeric(x) { return x !== undefined && x !== "" && x !== "close" && isFinite(parseFloat(x)); }
-function movable(k) {  // the lift at the end of segment k can be dragged: it ends a rise or return with a lift
-  const s = segments[k];
-  return liftSign(s) !== 0 && s.velocity === undefined && numeric(s.lift);
+function lifter(k) {  // the segment whose lift sets the height at the end of segment k (-1: none can)
+  let i = k;
+  while (i >= 0 && segments[i].kind === "dwell") i--;
+  const s = segments[i];
+  return i >= 0 && liftSign(s) !== 0 && s.velocity === undefined && numeric(s.lift) ? i : -1;
 }
+function movable(k) { return lifter(k) >= 0; }
 function blendPoints() {  // [{k, x [°], y}] of every boundary between two segments, y on the drawn curve
   const p = plots.s; if (!p || !p.chart) return [];
   const at = spans(), xs = p.chart.phi_deg, ys = p.chart.series[0].y;
@@ -387,15 +392,16 @@ function blendHook(u) {  // the blend points as handles on the displacement char
   ctx.restore();
 }
 function blendTo(k, x, lift0, y0, y) {  // the blend point after segment k to angle x [°] and height y
-  const d = y - y0, s = segments[k];
-  if (movable(k)) {
-    s.lift = String(+(parseFloat(lift0[k]) + liftSign(s) * d).toFixed(3));
-    const j = segments.findIndex((t, i) => i > k && liftSign(t) !== 0);
+  const d = y - y0, i = lifter(k);
+  if (i >= 0) {
+    const s = segments[i];
+    s.lift = String(+(parseFloat(lift0[i]) + liftSign(s) * d).toFixed(3));
+    const j = segments.findIndex((t, n) => n > k && liftSign(t) !== 0);
     if (j > k && numeric(lift0[j]) && segments[j].velocity === undefined) {
       segments[j].lift = String(+(parseFloat(lift0[j]) - liftSign(segments[j]) * d).toFixed(3));
     }
-    segments.forEach((t, i) => {
-      const f = document.getElementById(`f-motion-${i}-lift`); if (f && t.lift !== undefined) f.value = t.lift;
+    segments.forEach((t, n) => {
+      const f = document.getElementById(`f-motion-${n}-lift`); if (f && t.lift !== undefined) f.value = t.lift;
     });
   }
   dragTo(k, x);
@@ -423,11 +429,15 @@ function dragBoundaries(p) {  // drag the line between two segments: both spans 
     const b = nearPoint(ev), k = b ? b.k : near(ev); if (k < 0) return;
     ev.stopPropagation(); ev.preventDefault();
     const at = spans();
-    drag = {k, lo: at[k][0], hi: at[k + 1][1], point: b, lift0: segments.map(s => s.lift)};
+    // the chart's place when the drag began: a banner or status line changing above it while the mouse is
+    // held moves the chart, not the values the hand's movement means
+    drag = {k, lo: at[k][0], hi: at[k + 1][1], point: b, lift0: segments.map(s => s.lift),
+            rect: over.getBoundingClientRect()};
+    if (b) p.frozenY = [p.u.scales.y.min, p.u.scales.y.max];  // answers during the drag do not rescale
   }, true);
   window.addEventListener("mousemove", ev => {
     if (!drag) return;
-    const r = over.getBoundingClientRect();
+    const r = drag.rect;
     let x = Math.round(p.u.posToVal(ev.clientX - r.left, "x") * 2) / 2;
     x = Math.min(drag.hi - 0.5, Math.max(drag.lo + 0.5, x));
     if (!drag.point) { dragTo(drag.k, x); return; }
@@ -435,7 +445,12 @@ function dragBoundaries(p) {  // drag the line between two segments: both spans 
     blend = {k: drag.k, x, y};
     blendTo(drag.k, x, drag.lift0, drag.point.y, y);
   });
-  window.addEventListener("mouseup", () => { if (drag) { drag = null; blend = null; record(); drawBands(); } });
+  window.addEventListener("mouseup", () => {
+    if (!drag) return;
+    drag = null; blend = null; record();
+    if (p.frozenY) { p.frozenY = null; p.u.setData(p.u.data, true); }  // the scale fits the curve again
+    drawBands();
+  });
 }
 function dragTo(k, x) {  // the boundary after segment k to the angle x [°] (also used by tests and keyboard)
   const at = spans(), lo = at[k][0], hi = at[k + 1][1];
