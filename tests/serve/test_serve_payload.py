@@ -104,3 +104,32 @@ def test_each_chart_reaches_the_grid_extremes_and_the_answer_is_strict_json(samp
     assert np.hypot(*np.asarray(profile).T).max() == pytest.approx(
         out["drawing"]["profile_radius_max"], abs=5e-3
     )
+
+
+def test_an_edit_that_leaves_the_vibration_inputs_reuses_their_analysis():
+    """The speed map (seconds) is kept by its inputs: a new base radius reuses it, a new stiffness does
+    not; the kept result equals analyse_vibration() called afresh (summary.json's vibration section)."""
+    from dataclasses import replace
+
+    from camcad.design import load_design
+    from camcad.dynamics.vibration import analyse_vibration
+    from camcad.geometry import Cam
+
+    design = load_design(ROOT / "samples" / "vibration_speed_map.toml")
+    design = replace(design, vibration=replace(design.vibration, speed_points=5))  # a quick map
+    first = analyse(design, fit=False, toolpath=False, strict=False)
+    wider = replace(design, cam=replace(design.cam, base_radius=design.cam.base_radius + 5.0))
+    assert analyse(wider, fit=False, toolpath=False, strict=False).vibration is first.vibration
+    setup = design.dynamics_setup()
+    fresh = analyse_vibration(
+        Cam.from_design(design).program,
+        design.vibration,
+        design.dynamics,
+        speed_rpm=design.cam.speed_rpm,
+        arm_angle=setup.arm_angle,
+        spring_loaded=not setup.positive_drive,
+    )
+    assert json.dumps(fresh.summary(), default=str) == json.dumps(first.vibration.summary(), default=str)
+    stiffer = replace(design, vibration=replace(design.vibration, stiffness=2 * design.vibration.stiffness))
+    other = analyse(stiffer, fit=False, toolpath=False, strict=False).vibration
+    assert other is not first.vibration and other.summary() != first.vibration.summary()
