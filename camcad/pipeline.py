@@ -15,7 +15,7 @@ import sys
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
-from functools import partial
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import Any, cast
 
@@ -321,18 +321,32 @@ def analyse(
 
 
 def _vibration(design: Design, cam: Cam) -> Any:
-    """The ``[vibration]`` analysis of the design's motion program at its speed (issue 34)."""
-    from camcad.dynamics.vibration import analyse_vibration
+    """The ``[vibration]`` analysis of the design's motion program at its speed (issue 34).
 
+    The last few results are kept by their inputs (:func:`_vibration_of`): the
+    speed map takes seconds and most edits in ``camcad serve`` (the cam's size,
+    its follower's radius, a limit) leave every input of it as it was.
+    """
     assert design.vibration is not None
     setup = design.dynamics_setup()
+    args = (cam.program, design.vibration, design.dynamics, design.cam.speed_rpm, setup.arm_angle)
+    spring_loaded = not setup.positive_drive
+    try:
+        hash(args)
+    except TypeError:  # an input holding arrays (a point table's): computed, not kept
+        return _vibration_of.__wrapped__(*args, spring_loaded)
+    return _vibration_of(*args, spring_loaded)
+
+
+@lru_cache(maxsize=4)
+def _vibration_of(
+    program: Any, spec: Any, dynamics: Any, speed_rpm: float, arm_angle: float | None, spring_loaded: bool
+) -> Any:
+    """:func:`camcad.dynamics.vibration.analyse_vibration` of these frozen inputs (same in, same out)."""
+    from camcad.dynamics.vibration import analyse_vibration
+
     return analyse_vibration(
-        cam.program,
-        design.vibration,
-        design.dynamics,
-        speed_rpm=design.cam.speed_rpm,
-        arm_angle=setup.arm_angle,
-        spring_loaded=not setup.positive_drive,
+        program, spec, dynamics, speed_rpm=speed_rpm, arm_angle=arm_angle, spring_loaded=spring_loaded
     )
 
 

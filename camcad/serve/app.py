@@ -73,7 +73,7 @@ from urllib.parse import parse_qs, urlsplit
 from camcad.design import load_design, parse_design
 from camcad.errors import CamcadError, DesignError, UsageError
 from camcad.export.records import json_safe
-from camcad.serve.form import design_data, form_groups
+from camcad.serve.form import design_data, form_fields, form_groups
 from camcad.serve.page import STATIC, render_page
 from camcad.serve.payload import evaluate
 from camcad.serve.toml_edit import edit_toml
@@ -260,6 +260,7 @@ class Designer:
         self.loaded = _read_design(self.path)
         self.notice = ""
         self.written: set[str] = set()  # point tables this server wrote (it may write them again)
+        self._form: tuple[_Loaded, Mapping[str, Any]] | None = None  # the fields of the file loaded
         self._validate(self.loaded.data)  # refuse to start on an invalid file: fix it first
 
     def _validate(self, data: Mapping[str, Any]) -> None:
@@ -311,9 +312,17 @@ class Designer:
             motion=[t for t in base.get("motion", []) if isinstance(t, Mapping)],
         )
 
+    def _fields(self, loaded: _Loaded) -> Mapping[str, Any]:
+        """The form's fields of ``loaded`` (made once per file loaded or saved, not on every edit)."""
+        cached = self._form
+        if cached is None or cached[0] is not loaded:
+            cached = self._form = (loaded, form_fields(loaded.data))
+        return cached[1]
+
     def data(self, values: Mapping[str, Any]) -> dict[str, Any]:
         """The design mapping with the form's values applied; its point tables checked."""
-        data = design_data(self.loaded.data, values)
+        loaded = self.loaded
+        data = design_data(loaded.data, values, self._fields(loaded))
         _check_tables(data, self.folder)
         return data
 
@@ -336,7 +345,7 @@ class Designer:
         if revision and revision != loaded.stamp[1]:
             return self._conflict("was loaded again from disk after this page was made")
         try:
-            data = design_data(loaded.data, values)
+            data = design_data(loaded.data, values, self._fields(loaded))
             _check_tables(data, self.folder)
             parse_design(data, source=str(self.path))
         except DesignError as err:
@@ -506,8 +515,13 @@ class _Handler(BaseHTTPRequestHandler):
             self.wfile.write(body)
 
     def _json(self, status: int, data: Any) -> None:
-        # non-finite numbers as null, as summary.json writes them (camcad.export.records.json_safe)
-        body = json.dumps(json_safe(data), allow_nan=False)
+        # An analysis answer is JSON-ready by construction (payload.evaluate: finite numbers, None for
+        # gaps) and goes straight to the encoder; anything else (numpy values, non-finite numbers) takes
+        # the slower walk that writes them as summary.json does (camcad.export.records.json_safe).
+        try:
+            body = json.dumps(data, allow_nan=False)
+        except (TypeError, ValueError):
+            body = json.dumps(json_safe(data), allow_nan=False)
         self._send(status, body.encode("utf-8"), "application/json")
 
     def _refuse(self, status: int, message: str, extra: Mapping[str, str] | None = None) -> None:

@@ -257,21 +257,31 @@ def _motion(base: list[Any], values: Mapping[str, Any]) -> list[dict[str, Any]]:
     return tables
 
 
-def design_data(base: Mapping[str, Any], values: Mapping[str, Any]) -> dict[str, Any]:
+def form_fields(base: Mapping[str, Any]) -> dict[str, Field]:
+    """Every field of the form of ``base`` (:func:`form_groups`) by its path."""
+    return {f.path: f for g in form_groups(base) for f in (*g.fields, *g.more)}
+
+
+def design_data(
+    base: Mapping[str, Any], values: Mapping[str, Any], fields: Mapping[str, Field] | None = None
+) -> dict[str, Any]:
     """The design mapping with the form's ``values`` (path → input text) applied to ``base``.
 
     Paths not in ``values`` keep their value from ``base``; an empty input
     removes the key (the default applies). With ``motion.count`` the values
     hold the whole motion program (``motion[i].key``; see :func:`_motion`);
     without it a ``motion[i].key`` edits that key of the file's segment, its
-    blend tables kept.
+    blend tables kept. ``fields`` is :func:`form_fields` of ``base`` when the
+    caller keeps it (the server does, once per file loaded: the schema's work
+    is not redone on every edit).
     """
     out: dict[str, Any] = {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in base.items()}
     base_motion = list(base.get("motion", []))
     out["motion"] = [dict(t) if isinstance(t, Mapping) else t for t in base_motion]
     if "motion.count" in values:
         out["motion"] = _motion(base_motion, values)
-    fields = {f.path: f for g in form_groups(base) for f in (*g.fields, *g.more)}
+    if fields is None:
+        fields = form_fields(base)
     for path, text in values.items():
         match = _MOTION_PATH.fullmatch(path)
         if match and "motion.count" not in values:

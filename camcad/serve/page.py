@@ -110,10 +110,13 @@ details summary { cursor: pointer; color: var(--muted); font-size: 12.5px; margi
 .bar button { font: inherit; padding: 5px 12px; border-radius: 5px; border: 1px solid #1f5f9e;
               background: #1f5f9e; color: #fff; cursor: pointer; }
 .bar button.secondary { background: #fff; color: #1f5f9e; }
-#status { color: var(--muted); font-size: 12.5px; }
+#status { color: var(--muted); font-size: 12.5px; flex: 1 1 12em; min-width: 0; white-space: nowrap;
+          overflow: hidden; text-overflow: ellipsis; }
 #general-error:empty, #notice:empty { display: none; }
 body[data-state="invalid"] #cam-drawing, body[data-state="invalid"] .charts,
-body[data-state="invalid"] #cards { opacity: 0.45; }
+body[data-state="invalid"] #cards, body[data-state="invalid"] #speed-range { opacity: 0.45; }
+#speed-range { font-size: 13px; margin: 6px 0; }
+#speed-range:empty { display: none; }
 #cam-drawing svg { width: 100%; height: auto; display: block; max-height: 70vh; }
 .charts { display: grid; grid-template-columns: repeat(auto-fill, minmax(min(100%, 330px), 1fr)); gap: 10px;
           margin-top: 12px; }
@@ -209,7 +212,8 @@ def render_page(
         '<section id="motion-diagram" aria-label="motion diagram: drag a segment boundary on the '
         'displacement chart"></section>\n'
         '<section class="glance"><figure id="cam-drawing"><div id="cam-drawing-svg"></div>'
-        '<figcaption id="cam-caption"></figcaption></figure><div id="cards"></div></section>\n'
+        '<figcaption id="cam-caption"></figcaption></figure><div id="cards"></div>'
+        '<p id="speed-range" aria-live="polite"></p></section>\n'
         '<section class="charts" id="charts"></section>\n'
         '</main>\n</div>\n<script src="/static/designer.js"></script>\n</body>\n</html>\n'
     )

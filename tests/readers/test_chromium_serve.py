@@ -61,7 +61,8 @@ def _wait_for(browser, condition: str, what: str) -> None:
         if browser.execute_script(f"return Boolean({condition})"):
             return
         time.sleep(0.05)
-    raise AssertionError(f"timed out waiting for {what}")
+    status = browser.execute_script("return document.getElementById('status').textContent")
+    raise AssertionError(f"timed out waiting for {what} (status: {status!r})")
 
 
 def _shown(browser) -> dict:
@@ -350,6 +351,89 @@ def test_add_drag_delete_segments_save_and_rebuild(browser, tmp_path):
         assert browser.execute_script("return segments.length") == 4
 
 
+def _drag_point(browser, boundary: int, to_deg: float, to_lift: float) -> None:
+    """Drag the blend point after segment ``boundary`` on the s chart to (``to_deg``, ``to_lift``)."""
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    over = browser.find_element("css selector", "#chart-s .u-over")
+    x0, y0, x1, y1, width, height = browser.execute_script(
+        """
+        const u = plots.s.u, b = camcadBlendPoints().find(b => b.k === arguments[0]);
+        return [u.valToPos(b.x, 'x'), u.valToPos(b.y, 'y'), u.valToPos(arguments[1], 'x'),
+                u.valToPos(arguments[2], 'y'), u.over.clientWidth, u.over.clientHeight];
+        """,
+        boundary,
+        to_deg,
+        to_lift,
+    )
+    dx, dy = round(x1) - round(x0), round(y1) - round(y0)
+    chain = ActionChains(browser)
+    chain.move_to_element_with_offset(over, round(x0 - width / 2), round(y0 - height / 2)).click_and_hold()
+    chain.move_by_offset(dx // 2, dy // 2).move_by_offset(dx - dx // 2, dy - dy // 2)
+    chain.release().perform()
+
+
+def test_drag_a_blend_point_edits_angle_and_lift(browser, tmp_path):
+    """A blend point dragged on the chart: the saved TOML, the rebuilt cam and the redrawn point agree;
+    dragged below zero, the loader's own refusal shows under the lift it names."""
+    with _serve(tmp_path, "quintero_vap_b01") as (url, design):
+        _open(browser, url)
+        start = browser.execute_script("return camcadBlendPoints()[0]")
+        assert start["x"] == pytest.approx(150.0) and start["y"] == pytest.approx(30.0, abs=1e-6)
+        _edited(browser, lambda: _drag_point(browser, 0, 140.0, 36.0), "the drag")
+        assert browser.execute_script("return document.body.dataset.state") == "ok"
+        pixel = browser.execute_script(  # one pixel of the chart in the lift's unit and in degrees
+            "const u = plots.s.u; return [Math.abs(u.posToVal(0, 'y') - u.posToVal(1, 'y')),"
+            " Math.abs(u.posToVal(1, 'x') - u.posToVal(0, 'x'))]"
+        )
+        motion = _motion_saved(browser, design)
+        lift, angle = motion[0]["lift"], motion[0]["angle"]
+        assert lift == pytest.approx(36.0, abs=2 * pixel[0] + 0.01)
+        assert angle == pytest.approx(140.0, abs=2 * pixel[1] + 0.5)
+        # the rest of the program stays: the dwell ends at 240°, the return falls by the new lift
+        assert angle + motion[1]["angle"] == pytest.approx(240.0) and motion[1]["kind"] == "dwell"
+        assert motion[2] == {"kind": "return", "angle": 120.0, "lift": lift, "law": "vap", "b": 0.1}
+        result = analyse(load_design(design), fit=False, toolpath=False)
+        assert float(np.max(result.motion.s)) == pytest.approx(lift, abs=1e-9)
+        point = browser.execute_script("return camcadBlendPoints()[0]")
+        assert point["x"] == pytest.approx(angle) and point["y"] == pytest.approx(lift, abs=1e-5)
+        assert browser.execute_script("return +document.getElementById('chart-s').dataset.ymax") == (
+            pytest.approx(lift, abs=1e-5)
+        )
+        # the point where the dwell ends: its level moves with the rise before it and the return after it
+        _edited(browser, lambda: _drag_point(browser, 1, 250.0, lift - 6.0), "the dwell's end dragged")
+        motion = _motion_saved(browser, design)
+        lift2 = motion[0]["lift"]
+        assert lift2 == pytest.approx(lift - 6.0, abs=2 * pixel[0] + 0.01) and motion[2]["lift"] == lift2
+        assert motion[0]["angle"] == angle and motion[1]["angle"] + angle == pytest.approx(250.0, abs=1.0)
+        assert motion[1]["angle"] + motion[2]["angle"] == pytest.approx(360.0 - angle)
+        result = analyse(load_design(design), fit=False, toolpath=False)
+        assert float(np.max(result.motion.s)) == pytest.approx(lift2, abs=1e-9)
+        lift, angle = lift2, motion[0]["angle"]
+
+        # below the base circle: the loader refuses, and the page says so under the field it names
+        _edited(browser, lambda: _drag_point(browser, 0, angle, -12.0), "the refused drag")
+        assert browser.execute_script("return document.body.dataset.state") == "invalid"
+        shown = browser.execute_script(
+            "return [0, 1, 2].map(i => (document.getElementById(`f-motion-${i}-lift`) || {}).value)"
+        )
+        data = tomllib.loads(design.read_text(encoding="utf-8"))
+        data["motion"][0]["lift"], data["motion"][2]["lift"] = float(shown[0]), float(shown[2])
+        assert float(shown[0]) < 0
+        from camcad.design import parse_design
+
+        with pytest.raises(DesignError) as caught:
+            parse_design(data)
+        message = browser.execute_script(
+            "return document.querySelector(`.err[data-for='${arguments[0]}']`).textContent", caught.value.path
+        )
+        assert caught.value.path.startswith("motion[") and message == caught.value.message
+        # Save refuses the invalid program; the file keeps the last saved one
+        browser.find_element("id", "save").click()
+        _wait_for(browser, "document.getElementById('status').textContent.startsWith('not saved')", "refusal")
+        assert tomllib.loads(design.read_text(encoding="utf-8"))["motion"] == motion
+
+
 def test_upload_a_table_switch_follower_and_family(browser, tmp_path):
     """An uploaded CSV is written beside the design as it was and drawn as points; the follower switches."""
     with _serve(tmp_path, "offset_roller") as (url, design):
@@ -505,3 +589,42 @@ def test_tab_reaches_every_control_and_each_has_a_name(browser, served):
         "return [document.scrollingElement.scrollWidth, document.scrollingElement.clientWidth]"
     )
     assert scroll <= client
+
+
+def test_an_unbounded_speed_range_reads_no_upper_limit(browser, tmp_path):
+    """rotary_plate keeps its follower on at every speed (the range's upper end is inf in camcad): the page
+    says "no upper limit", in the glance and in the compare table, never inf, NaN or a blank; a bounded
+    range (quintero_vap_b01) shows its upper speed as the analysis gives it."""
+    import math
+
+    with _serve(tmp_path, "rotary_plate") as (url, design):
+        _open(browser, url)
+        low, high = analyse(load_design(design), fit=False, toolpath=False, strict=False).summary()[
+            "dynamics"
+        ]["speed_range_rpm"]
+        assert math.isinf(high)  # independent of the page: the range is unbounded above
+        shown = browser.find_element("id", "speed-range-value").text
+        assert shown == f"{float(f'{low:.4g}'):g} rpm to no upper limit"
+        browser.find_element("id", "pin").click()
+        field = browser.find_element("name", "cam.base_radius")
+        field.clear()
+        _edited(browser, lambda: field.send_keys("61"), "the edit")
+        row = browser.execute_script(
+            "return [...document.querySelectorAll("
+            "'#compare-table tr[data-key=\"dynamics.speed_range_rpm\"] td')].map(td => td.textContent)"
+        )
+        assert row[1] == row[2] == shown
+        text = browser.find_element("tag name", "main").text
+        for word in ("inf", "Infinity", "NaN", "undefined", "null"):
+            assert word not in text.replace("Information", ""), word
+        browser.find_element("id", "pin").click()
+
+    second = tmp_path / "bounded"
+    second.mkdir()
+    with _serve(second, "quintero_vap_b01") as (url, design):
+        _open(browser, url)
+        low, high = analyse(load_design(design), fit=False, toolpath=False).summary()["dynamics"][
+            "speed_range_rpm"
+        ]
+        shown = browser.find_element("id", "speed-range-value").text
+        assert shown == f"{float(f'{low:.4g}'):g} rpm to {float(f'{high:.4g}'):g} rpm"

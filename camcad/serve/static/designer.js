@@ -227,14 +227,25 @@ document.addEventListener("keydown", ev => {
 
 // ------------------------------------------------------------------ the charts (uPlot)
 const plots = {};  // key → {u, box, chart}
-function interp(xs, ys, x) {  // ys at x on the grid xs (linear; the pinned curves on the current grid)
+function interp(xs, ys, x) {  // ys at x on the grid xs: exact at its own samples, linear between
   let lo = 0, hi = xs.length - 1;
   if (!(x >= xs[lo] && x <= xs[hi])) return null;
   while (hi - lo > 1) { const m = (lo + hi) >> 1; if (xs[m] <= x) lo = m; else hi = m; }
+  if (x === xs[lo]) return ys[lo];
+  if (x === xs[hi]) return ys[hi];
   const a = ys[lo], b = ys[hi];
   if (a === null || b === null) return null;
-  const t = xs[hi] === xs[lo] ? 0 : (x - xs[lo]) / (xs[hi] - xs[lo]);
-  return a + t * (b - a);
+  return a + (x - xs[lo]) / (xs[hi] - xs[lo]) * (b - a);
+}
+function union(a, b) {  // two sorted angle lists merged, each angle once
+  const out = []; let i = 0, k = 0;
+  while (i < a.length || k < b.length) {
+    const x = k >= b.length || (i < a.length && a[i] <= b[k]) ? a[i] : b[k];
+    if (i < a.length && a[i] === x) i++;
+    if (k < b.length && b[k] === x) k++;
+    out.push(x);
+  }
+  return out;
 }
 const MOTION = ["s", "v", "a", "j"];
 function bandsHook(u) {
@@ -272,17 +283,18 @@ function overlayHook(u) {  // limit lines and a point table's own points
 }
 function chartWidth(box) { return Math.max(200, Math.floor(box.clientWidth || 320)); }
 
-function plotData(chart, phi) {
+function plotData(chart) {  // each chart comes on its own (min-max decimated) angles
+  const old = pinned ? pinned.charts.find(c => c.key === chart.key) : null;
+  const phi = old ? union(chart.phi_deg, old.phi_deg) : chart.phi_deg;  // both curves keep every sample
   const data = [phi], series = [{label: "φ [°]", value: (u, v) => v == null ? "–" : v.toFixed(1)}];
   chart.series.forEach((s, k) => {
-    data.push(s.y);
+    data.push(old ? phi.map(x => interp(chart.phi_deg, s.y, x)) : s.y);
     series.push({label: s.label + (chart.unit ? ` [${chart.unit}]` : ""), stroke: COLORS[k % COLORS.length], width: 1.4,
                  value: (u, v) => v == null ? "–" : +v.toPrecision(5)});
   });
-  if (pinned) {
-    const old = pinned.charts.find(c => c.key === chart.key);
-    if (old) old.series.forEach((s, k) => {
-      data.push(phi.map(x => interp(pinned.phi, s.y, x)));
+  if (old) {
+    old.series.forEach((s, k) => {
+      data.push(phi.map(x => interp(old.phi_deg, s.y, x)));
       series.push({label: "pinned " + s.label, stroke: "#7d7d7d", width: 1.2, dash: [6, 4],
                    value: (u, v) => v == null ? "–" : +v.toPrecision(5)});
     });
@@ -291,9 +303,9 @@ function plotData(chart, phi) {
   return {data, series};
 }
 
-function drawChart(parent, chart, phi, motion) {
+function drawChart(parent, chart, motion) {
   let p = plots[chart.key];
-  const {data, series} = plotData(chart, phi);
+  const {data, series} = plotData(chart);
   const sig = series.map(s => s.label).join("|");
   if (!p) {
     const fig = document.createElement("figure"); fig.className = "chart";
@@ -322,12 +334,13 @@ function drawChart(parent, chart, phi, motion) {
     width: chartWidth(p.box), height: 200, series,
     scales: {x: {time: false, range: (u, a, b) => [a ?? 0, b ?? 360]},
              y: {range: (u, a, b) => {
+               if (p.frozenY) return p.frozenY;  // a blend point is being dragged: the scale holds still
                for (const l of p.chart.limits || []) { a = Math.min(a, l); b = Math.max(b, l); }
                const pad = (b - a) * 0.06 || 1; return [a - pad, b + pad]; }}},
     axes: [{values: (u, v) => v.map(x => x + "°")}, {size: 56}],
     cursor: {drag: {x: true, y: false}},
     legend: {live: true},
-    hooks: {drawClear: motion ? [bandsHook] : [], draw: [overlayHook],
+    hooks: {drawClear: motion ? [bandsHook] : [], draw: motion ? [overlayHook, blendHook] : [overlayHook],
             setScale: [(u, key) => { if (key === "x") p.zoomed = !(u.scales.x.min <= 0.01 && u.scales.x.max >= 359.99); }]},
   };
   p.u = new uPlot(opts, data, p.box);
@@ -338,6 +351,62 @@ function drawChart(parent, chart, phi, motion) {
 function drawBands() { for (const k of MOTION) if (plots[k] && plots[k].u) plots[k].u.redraw(false, false); }
 window.addEventListener("resize", () => { for (const p of Object.values(plots)) if (p.u) p.u.setSize({width: chartWidth(p.box), height: 200}); });
 
+// Blend points: the ends of the segments on the displacement chart, at (angle, lift). Dragging one moves
+// the boundary (as the line does) and, up or down, the lift there: the last rise or return up to it (the
+// segment itself, or the one before the dwells ending there) rises or falls by as much more, and the next
+// rise or return after it by as much less, so the rest of the program stays where it was ("close" closes
+// by itself). The values go through the editor's fields and the same analysis as typing them; a value the
+// loader refuses shows its message under the field.
+let blend = null;  // {k, x, y} while a blend point is dragged (drawn at the cursor until the answer comes)
+function liftSign(s) { return s.kind === "rise" ? 1 : s.kind === "return" ? -1 : 0; }
+function numeric(x) { return x !== undefined && x !== "" && x !== "close" && isFinite(parseFloat(x)); }
+function lifter(k) {  // the segment whose lift sets the height at the end of segment k (-1: none can)
+  let i = k;
+  while (i >= 0 && segments[i].kind === "dwell") i--;
+  const s = segments[i];
+  return i >= 0 && liftSign(s) !== 0 && s.velocity === undefined && numeric(s.lift) ? i : -1;
+}
+function movable(k) { return lifter(k) >= 0; }
+function blendPoints() {  // [{k, x [°], y}] of every boundary between two segments, y on the drawn curve
+  const p = plots.s; if (!p || !p.chart) return [];
+  const at = spans(), xs = p.chart.phi_deg, ys = p.chart.series[0].y;
+  const out = [];
+  for (let k = 0; k < segments.length - 1; k++) {
+    const y = interp(xs, ys, at[k][1]);
+    if (y !== null) out.push({k, x: at[k][1], y});
+  }
+  return out;
+}
+window.camcadBlendPoints = blendPoints;
+function blendHook(u) {  // the blend points as handles on the displacement chart
+  if (u.root.dataset.key !== "s") return;
+  const ctx = u.ctx, r = devicePixelRatio;
+  ctx.save();
+  for (const b of blendPoints()) {
+    const at = blend && blend.k === b.k ? blend : b;
+    const x = u.valToPos(at.x, "x", true), y = u.valToPos(at.y, "y", true);
+    ctx.beginPath(); ctx.arc(x, y, 5 * r, 0, 2 * Math.PI);
+    ctx.fillStyle = movable(b.k) ? "#fff" : "#eee"; ctx.fill();
+    ctx.lineWidth = 2 * r; ctx.strokeStyle = "#1f3b57"; ctx.stroke();
+  }
+  ctx.restore();
+}
+function blendTo(k, x, lift0, y0, y) {  // the blend point after segment k to angle x [°] and height y
+  const d = y - y0, i = lifter(k);
+  if (i >= 0) {
+    const s = segments[i];
+    s.lift = String(+(parseFloat(lift0[i]) + liftSign(s) * d).toFixed(3));
+    const j = segments.findIndex((t, n) => n > k && liftSign(t) !== 0);
+    if (j > k && numeric(lift0[j]) && segments[j].velocity === undefined) {
+      segments[j].lift = String(+(parseFloat(lift0[j]) - liftSign(segments[j]) * d).toFixed(3));
+    }
+    segments.forEach((t, n) => {
+      const f = document.getElementById(`f-motion-${n}-lift`); if (f && t.lift !== undefined) f.value = t.lift;
+    });
+  }
+  dragTo(k, x);
+}
+
 function dragBoundaries(p) {  // drag the line between two segments: both spans change, their sum stays
   const over = p.u.over;
   let drag = null;
@@ -346,21 +415,42 @@ function dragBoundaries(p) {  // drag the line between two segments: both spans 
     for (let k = 0; k < segments.length - 1; k++) if (Math.abs(p.u.valToPos(at[k][1], "x") - x) < 7) return k;
     return -1;
   };
-  over.addEventListener("mousemove", ev => { if (!drag) over.style.cursor = near(ev) >= 0 ? "ew-resize" : ""; });
+  const nearPoint = ev => {  // a blend point within 8 px (displacement chart only)
+    if (p.chart.key !== "s") return null;
+    const r = over.getBoundingClientRect(), x = ev.clientX - r.left, y = ev.clientY - r.top;
+    return blendPoints().find(b => Math.hypot(p.u.valToPos(b.x, "x") - x, p.u.valToPos(b.y, "y") - y) < 8) || null;
+  };
+  over.addEventListener("mousemove", ev => {
+    if (drag) return;
+    const b = nearPoint(ev);
+    over.style.cursor = b ? (movable(b.k) ? "move" : "ew-resize") : near(ev) >= 0 ? "ew-resize" : "";
+  });
   over.addEventListener("mousedown", ev => {
-    const k = near(ev); if (k < 0) return;
+    const b = nearPoint(ev), k = b ? b.k : near(ev); if (k < 0) return;
     ev.stopPropagation(); ev.preventDefault();
     const at = spans();
-    drag = {k, lo: at[k][0], hi: at[k + 1][1]};
+    // the chart's place when the drag began: a banner or status line changing above it while the mouse is
+    // held moves the chart, not the values the hand's movement means
+    drag = {k, lo: at[k][0], hi: at[k + 1][1], point: b, lift0: segments.map(s => s.lift),
+            rect: over.getBoundingClientRect()};
+    if (b) p.frozenY = [p.u.scales.y.min, p.u.scales.y.max];  // answers during the drag do not rescale
   }, true);
   window.addEventListener("mousemove", ev => {
     if (!drag) return;
-    const r = over.getBoundingClientRect();
+    const r = drag.rect;
     let x = Math.round(p.u.posToVal(ev.clientX - r.left, "x") * 2) / 2;
     x = Math.min(drag.hi - 0.5, Math.max(drag.lo + 0.5, x));
-    dragTo(drag.k, x);
+    if (!drag.point) { dragTo(drag.k, x); return; }
+    const y = movable(drag.k) ? Math.round(p.u.posToVal(ev.clientY - r.top, "y") * 100) / 100 : drag.point.y;
+    blend = {k: drag.k, x, y};
+    blendTo(drag.k, x, drag.lift0, drag.point.y, y);
   });
-  window.addEventListener("mouseup", () => { if (drag) { drag = null; record(); } });
+  window.addEventListener("mouseup", () => {
+    if (!drag) return;
+    drag = null; blend = null; record();
+    if (p.frozenY) { p.frozenY = null; p.u.setData(p.u.data, true); }  // the scale fits the curve again
+    drawBands();
+  });
 }
 function dragTo(k, x) {  // the boundary after segment k to the angle x [°] (also used by tests and keyboard)
   const at = spans(), lo = at[k][0], hi = at[k + 1][1];
@@ -439,6 +529,25 @@ function showErrors(errors) {
     }
   }
 }
+// The speed range that keeps a spring-held follower on the cam: summary.json's [low, high] rpm, where an
+// unbounded end is null (infinite in camcad: no speed up to it lifts the follower off the cam).
+function rpm(v) { return (+v.toPrecision(4)) + " rpm"; }
+function speedRange(range) {
+  if (range === null) return "none: the follower leaves the cam at every speed";
+  const [lo, hi] = range;
+  const low = lo === null || !isFinite(lo) ? "no lower limit" : rpm(lo);
+  const high = hi === null || !isFinite(hi) ? "no upper limit" : rpm(hi);
+  return low + " to " + high;
+}
+function showSpeedRange(out) {
+  const box = document.getElementById("speed-range"), dyn = (out.summary || {}).dynamics || {};
+  if (!("speed_range_rpm" in dyn)) { box.replaceChildren(); return; }  // a positive drive: no such range
+  const words = document.createElement("span"); words.textContent = "Speed range without leaving the cam: ";
+  const value = document.createElement("strong"); value.id = "speed-range-value";
+  value.textContent = speedRange(dyn.speed_range_rpm);
+  const tag = document.createElement("span"); tag.className = "stale-tag"; tag.textContent = " out of date";
+  box.replaceChildren(words, value, tag);
+}
 const STALE = '<section class="alert bad" id="stale"><h2>Out of date</h2><p>The input is invalid (see the ' +
   'field marked): the drawing, numbers and curves below are those of the last valid design.</p></section>';
 function render(out) {
@@ -457,11 +566,12 @@ function render(out) {
     for (const card of cards.querySelectorAll(".card .label")) {
       const tag = document.createElement("span"); tag.className = "stale-tag"; tag.textContent = " out of date"; card.append(tag);
     }
+    showSpeedRange(out);
     drawCam(document.getElementById("cam-drawing-svg"), out.drawing);
     document.getElementById("cam-caption").textContent = out.drawing.caption;
     for (const chart of out.charts) {
       const motion = MOTION.includes(chart.key);
-      drawChart(document.getElementById(motion ? "motion-diagram" : "charts"), chart, out.phi_deg, motion);
+      drawChart(document.getElementById(motion ? "motion-diagram" : "charts"), chart, motion);
     }
   } else {
     alerts.innerHTML = STALE;  // no "No warnings" while invalid: the old banner said nothing about this input
@@ -488,17 +598,25 @@ function unreachable() {
 
 let notes = 0;  // counts save and build messages: an analysis that began before one does not overwrite it
 
-async function analyse() {
+let inflight = false, again = false;  // one analysis at a time per page; edits meanwhile coalesce into one
+
+async function analyse(notesFrom) {  // notesFrom: the notes count when the change now sent was first sent
+  if (inflight) { again = true; waiting = true; settle(); return; }
+  inflight = true;
   waiting = false;
   const id = ++sent;
-  const notesBefore = notes, since = editAt;
+  const notesBefore = typeof notesFrom === "number" ? notesFrom : notes, since = editAt;
   editAt = null;
   settle();
-  status.textContent = "analysing…";
+  if (notes === notesBefore) status.textContent = "analysing…";  // a save or build said since stays said
   const started = performance.now();
   let out;
   try { out = await answer(await post("/api/analyse", {values: values()})); } catch (err) { out = unreachable(); }
-  if (id !== sent) return;  // a newer change is on its way
+  inflight = false;
+  if (again) {  // a newer change came meanwhile: send it (its latency counted from the first change undrawn)
+    again = false; if (since !== null) editAt = since; analyse(notesBefore); return;
+  }
+  if (id !== sent) return;
   const answered = performance.now();
   render(out);
   await new Promise(r => requestAnimationFrame(() => r()));
@@ -551,12 +669,17 @@ function compareTable(now) {
       for (const t of [words, f(a[key]), f(b[key]), (d > 0 ? "+" : "") + (+d.toPrecision(4))]) row.insertCell().textContent = t;
     }
   }
+  const a = (pinned.summary.dynamics || {}), b = (now.summary.dynamics || {});
+  if ("speed_range_rpm" in a && "speed_range_rpm" in b) {
+    const row = body.insertRow(); row.dataset.key = "dynamics.speed_range_rpm";
+    for (const t of ["speed range without leaving", speedRange(a.speed_range_rpm), speedRange(b.speed_range_rpm), ""]) row.insertCell().textContent = t;
+  }
   box.replaceChildren(table);
 }
 const pinButton = document.getElementById("pin");
 pinButton.addEventListener("click", () => {
   if (pinned) { pinned = null; }
-  else if (last) { pinned = {phi: last.phi_deg, charts: last.charts, summary: last.summary}; }
+  else if (last) { pinned = {charts: last.charts, summary: last.summary}; }
   pinButton.setAttribute("aria-pressed", pinned ? "true" : "false");
   pinButton.textContent = pinned ? "Unpin" : "Pin for compare";
   document.getElementById("pin-note").textContent = pinned ? "pinned curves: grey dashed" : "";
