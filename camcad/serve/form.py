@@ -169,7 +169,9 @@ def motion_info() -> dict[str, Any]:
 def form_groups(data: Mapping[str, Any]) -> list[Group]:
     """The form of a design mapping: one group per table in TOML order (the motion is the page's editor)."""
     groups = []
-    schema = _schema()["properties"]
+    root = _schema()
+    schema = root["properties"]
+    conditional = _conditional_required(root, data)
     sections = [s for s in _SECTION_ORDER if s in schema and s != "motion"]
     sections += [s for s in schema if s not in sections and s != "motion"]
     for section in sections:
@@ -177,7 +179,7 @@ def form_groups(data: Mapping[str, Any]) -> list[Group]:
         if not isinstance(table, Mapping):
             continue
         props = schema[section]["properties"]
-        required = set(schema[section].get("required", ()))
+        required = set(schema[section].get("required", ())) | conditional.get(section, set())
         given = tuple(
             _field(section, k, props[k], v, required=k in required) for k, v in table.items() if k in props
         )
@@ -312,3 +314,20 @@ def toml_text(data: Mapping[str, Any], *, header: str = "") -> str:
     """The design mapping as TOML text in the form's table order (:mod:`camcad.design.toml_text`)."""
     order = [s for s in _SECTION_ORDER if s in data] + [s for s in data if s not in _SECTION_ORDER]
     return design_toml_text({s: data[s] for s in order}, header=header)
+
+
+def _conditional_required(root: Mapping[str, Any], data: Mapping[str, Any]) -> dict[str, set[str]]:
+    """The keys a style requires (the schema's ``allOf`` of if ``cam.style`` = … then/else), per table.
+
+    A barrel requires ``barrel_radius`` and ``length`` and every other style
+    ``base_radius``: the JSON Schema states it as one condition on the style.
+    """
+    cam = data.get("cam", {})
+    style = cam.get("style", "plate") if isinstance(cam, Mapping) else "plate"
+    out: dict[str, set[str]] = {}
+    for rule in root.get("allOf", ()):
+        const = rule["if"]["properties"]["cam"]["properties"]["style"]["const"]
+        branch = rule["then"] if style == const else rule["else"]
+        for section, table in branch["properties"].items():
+            out.setdefault(section, set()).update(table.get("required", ()))
+    return out
