@@ -12,11 +12,20 @@ time for 10⁶ designs on a 64-core cluster is 10⁶ / (64 × the per-core
 rate), from the rate of one core alone and from that of the 2-worker
 LocalCluster. The machine's load average is printed too:
 on a shared machine the figures move with it.
+
+First, the batch analysis (issue 38, :mod:`camcad.explore.batch`) against the
+per-design path, in one run: for every shipped plate-cam sample, 32 variants
+of its base radius (r_b to 1.25·r_b) in chunks of 16, each chunk's rows
+computed with batching off (each variant analysed alone, as before issue 38)
+and on, CPU time of this process (``time.process_time``, the best of
+``--repeats`` alternating runs), the rows checked identical. The ratio is
+designs per CPU-second batched over one at a time.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import sys
@@ -52,6 +61,91 @@ def plan(designs: int, chunk: int) -> SweepPlan:
     )
 
 
+BATCH_SAMPLES = (
+    "offset_roller",
+    "fea_plate",
+    "hren_tappet",
+    "indexing_drive",
+    "measured_table",
+    "packaging_rocker",
+    "quintero_harmonic",
+    "quintero_poly4567",
+    "quintero_vap_b01",
+    "quintero_vap_b02",
+    "rocker_flat",
+    "rotary_plate",
+    "tolerance_roller",
+    "web_cutter",
+)
+"""The shipped plate cams without ``[vibration]`` (a groove, a pair, a linear cam: one by one)."""
+
+
+def batch_plan(name: str, designs: int = 32, chunk: int = 16) -> SweepPlan:
+    path = ROOT / "samples" / f"{name}.toml"
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    r = float(data["cam"]["base_radius"])
+    variables = (
+        parse_variable(f"base_radius={r!r}:{1.25 * r!r}:{designs}", data, flag="--grid", counted=True),
+    )
+    return SweepPlan(
+        data=data,
+        source=str(path),
+        variables=variables,
+        points=tuple(grid_points(variables)),
+        pareto=(MEASURES["base_radius"], MEASURES["contact_stress"]),
+        chunk_size=chunk,
+    )
+
+
+def batch_table(repeats: int) -> None:
+    """Designs per CPU-second of this process, one at a time and batched, per sample; rows compared."""
+    from dataclasses import replace
+
+    from camcad.explore.batch import BatchStats, chunk_rows
+
+    heads = ("sample", "follower", "designs", "one at a time [designs/CPU-s]", "batched [designs/CPU-s]")
+    print("| " + " | ".join((*heads, "ratio", "batched variants", "same rows")) + " |")
+    print("|---|---|---|---|---|---|---|---|")
+    total_one = total_batch = 0.0
+    count = 0
+    for name in BATCH_SAMPLES:
+        p = batch_plan(name)
+        chunks = p.chunks()
+        n = len(p.points)
+
+        def run(batch: bool, chunks=chunks) -> tuple[float, list]:
+            start = time.process_time()
+            rows = [row for c in chunks for row in evaluate_chunk(replace(c, batch=batch))]
+            return time.process_time() - start, rows
+
+        run(True)  # imports, caches
+        one = many = math.inf
+        rows_one = rows_many = None
+        for _ in range(repeats):
+            t, rows_one = run(False)
+            one = min(one, t)
+            t, rows_many = run(True)
+            many = min(many, t)
+        stats = BatchStats()
+        for c in chunks:
+            chunk_rows(c.data, c.variables, c.points, limits=c.limits, source=c.source, stats=stats)
+        same = json.dumps(rows_one, sort_keys=True, default=repr) == json.dumps(
+            rows_many, sort_keys=True, default=repr
+        )
+        kind = p.data["follower"].get("type", "translating-roller")
+        print(
+            f"| {name} | {kind} | {n} | {n / one:.1f} | {n / many:.1f} | {one / many:.2f}× "
+            f"| {stats.batched}/{n} | {'yes' if same else 'NO'} |"
+        )
+        total_one += one
+        total_batch += many
+        count += n
+    print(
+        f"\nAll samples: {count / total_one:.1f} designs per CPU-second one at a time, "
+        f"{count / total_batch:.1f} batched: **{total_one / total_batch:.2f}×**.\n"
+    )
+
+
 def timed_map(submit_all, chunks) -> float:
     start = time.perf_counter()
     submit_all(chunks)
@@ -62,7 +156,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--designs", type=int, default=96)
     parser.add_argument("--chunk", type=int, default=8)
+    parser.add_argument(
+        "--repeats", type=int, default=3, help="alternating runs of each path (the best counts)"
+    )
+    parser.add_argument("--batch-only", action="store_true", help="only the batch table")
     args = parser.parse_args()
+    batch_table(args.repeats)
+    if args.batch_only:
+        return
     p = plan(args.designs, args.chunk)
     chunks = p.chunks()
     n = len(p.points)

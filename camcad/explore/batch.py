@@ -54,7 +54,7 @@ if TYPE_CHECKING:
     from camcad.geometry.curves import CurveSample
     from camcad.motion.program import Motion
 
-__all__ = ["BatchStats", "analyse_one", "analyse_rows", "structure_key"]
+__all__ = ["BatchStats", "analyse_many", "analyse_one", "analyse_rows", "chunk_rows", "structure_key"]
 
 
 @dataclass(slots=True)
@@ -541,6 +541,41 @@ def _assemble(design: Design, cam: Cam) -> Analysis:
 Row = dict[str, Any]
 
 
+def analyse_many(
+    designs: Sequence[Design],
+    *,
+    batch: bool = True,
+    stats: BatchStats | None = None,
+) -> list[Analysis | CamcadError]:
+    """Each design's analysis (as :func:`analyse_one`), or the error it raised, in order.
+
+    With ``batch`` the designs of one structure (:func:`structure_key`) are
+    analysed together (see the module notes), the others one by one; every
+    analysis is the same either way, to the bit.
+    """
+    stats = stats if stats is not None else BatchStats()
+    out: list[Analysis | CamcadError | None] = [None] * len(designs)
+    groups: dict[str, list[int]] = {}
+    for i, d in enumerate(designs):
+        key = structure_key(d) if batch else None
+        if key is None:
+            out[i] = _single(d)
+            stats.single += 1
+        else:
+            groups.setdefault(key, []).append(i)
+    for members in groups.values():
+        done = _batched([designs[i] for i in members], stats) if len(members) > 1 else None
+        if done is None:
+            for i in members:
+                out[i] = _single(designs[i])
+            stats.single += len(members)
+            continue
+        for i, got in zip(members, done, strict=True):
+            out[i] = got
+        stats.batched += len(members)
+    return [a for a in out if a is not None]
+
+
 def analyse_rows(
     designs: Sequence[Design | CamcadError],
     limits: Sequence[Limit] = (),
@@ -550,50 +585,30 @@ def analyse_rows(
 ) -> list[Row]:
     """The sweep row (:func:`~camcad.explore.measures.analysis_row`) of each design, in order.
 
-    A design given as the error its variant raised becomes its failed row.
-    With ``batch`` the designs of one structure are analysed together (see
-    the module notes), else one by one; the rows are the same either way.
+    A design given as the error its variant raised becomes its failed row;
+    the rows are the same bytes with ``batch`` on or off.
     """
-    stats = stats if stats is not None else BatchStats()
-    rows: list[Row | None] = [None] * len(designs)
-    groups: dict[str, list[int]] = {}
-    for i, d in enumerate(designs):
-        if isinstance(d, CamcadError):
-            rows[i] = failed_row(d, limits)
-            continue
-        key = structure_key(d) if batch else None
-        if key is None:
-            rows[i] = _single(d, limits)
-            stats.single += 1
-        else:
-            groups.setdefault(key, []).append(i)
-    for members in groups.values():
-        done = (
-            _batched([cast("Design", designs[i]) for i in members], limits, stats)
-            if len(members) > 1
-            else None
-        )
-        if done is None:
-            for i in members:
-                rows[i] = _single(cast("Design", designs[i]), limits)
-            stats.single += len(members)
-            continue
-        for i, row in zip(members, done, strict=True):
-            rows[i] = row
-        stats.batched += len(members)
-    return [r for r in rows if r is not None]
+    from camcad.analysis import Analysis
+
+    valid = [d for d in designs if not isinstance(d, CamcadError)]
+    analysed = iter(analyse_many(valid, batch=batch, stats=stats))
+    rows: list[Row] = []
+    for d in designs:
+        got = d if isinstance(d, CamcadError) else next(analysed)
+        rows.append(analysis_row(got, limits) if isinstance(got, Analysis) else failed_row(got, limits))
+    return rows
 
 
-def _single(design: Design, limits: Sequence[Limit]) -> Row:
+def _single(design: Design) -> Analysis | CamcadError:
     try:
-        analysis = analyse_one(design)
+        return analyse_one(design)
     except CamcadError as err:
-        return failed_row(err, limits)
-    return analysis_row(analysis, limits)
+        return err
 
 
-def _batched(designs: list[Design], limits: Sequence[Limit], stats: BatchStats) -> list[Row] | None:
-    """The rows of one structure's designs analysed together; None where the stacked cam cannot."""
+def _batched(designs: list[Design], stats: BatchStats) -> list[Analysis | CamcadError] | None:
+    """One structure's designs analysed together; None where the stacked cam cannot."""
+    from camcad.analysis import motion_summary
     from camcad.extremes import served
 
     try:
@@ -602,24 +617,23 @@ def _batched(designs: list[Design], limits: Sequence[Limit], stats: BatchStats) 
             states, answers = _searches(group)
     except (_Unsupported, CamcadError, ValueError, TypeError, AttributeError, IndexError):
         return None
-    rows: list[Row] = []
-    motion_summary: Any = None
+    out: list[Analysis | CamcadError] = []
+    shared: Any = None
     for design, cam, state, mine in zip(designs, group.cams, states, answers, strict=True):
         cam.keep_state(group.phi, replace(state, motion=group.grid_motion))
         with served(mine) as held:
             try:
                 analysis = _assemble(design, cam)
             except CamcadError as err:
-                rows.append(failed_row(err, limits))
+                out.append(err)
                 continue
         stats.served += held.used
         stats.searches += len(mine)
-        if motion_summary is not None:
-            analysis._memo["motion"] = motion_summary  # one program: one motion summary (copied by summary())
-        rows.append(analysis_row(analysis, limits))
-        if motion_summary is None:
-            motion_summary = analysis._memo.get("motion")
-    return rows
+        if shared is None:  # one program and lift unit: one motion summary (summary() hands out copies)
+            shared = motion_summary(analysis.cam, analysis.motion)
+        analysis._memo["motion"] = shared
+        out.append(analysis)
+    return out
 
 
 def chunk_rows(

@@ -98,7 +98,17 @@ def evaluate_point(
 
 
 def evaluate_chunk(chunk: Chunk) -> list[dict[str, Any]]:
-    """The rows of one chunk, each with its ``index`` in the sweep (what a worker runs)."""
+    """The rows of one chunk, each with its ``index`` in the sweep (what a worker runs).
+
+    With ``chunk.batch`` the chunk's variants that share one motion structure
+    are analysed together (:mod:`camcad.explore.batch`), the others one by
+    one (:func:`evaluate_point`); the rows are the same bytes either way.
+    """
+    if chunk.batch:
+        from camcad.explore.batch import chunk_rows
+
+        rows = chunk_rows(chunk.data, chunk.variables, chunk.points, limits=chunk.limits, source=chunk.source)
+        return [{"index": chunk.start + i} | row for i, row in enumerate(rows)]
     return [
         {"index": chunk.start + i}
         | evaluate_point(chunk.data, chunk.variables, values, limits=chunk.limits, source=chunk.source)
