@@ -128,7 +128,7 @@ def test_sweep_csv_same_bytes_with_batching_on_and_off(tmp_path) -> None:
 
 
 def test_mixed_structures_fall_back_and_match() -> None:
-    """Two laws (two motion structures), an invalid variant and an oscillating arm's moving pivot, in one chunk.
+    """Two laws (two motion structures), a refused variant, an arm whose pivot moves: all in one chunk.
 
     The laws form two groups, each analysed together; the refused variant
     (offset beyond r_b + r_f) is its failed row; the rocker's base-radius
