@@ -235,3 +235,28 @@ def test_bracket_finder_follows_its_rule(data, cuts) -> None:
         elif next_in:
             expected.add((r, float(phi[i]), float(phi[i + 1])))
     assert found == expected
+
+
+def test_optimize_same_result_with_batched_gradients() -> None:
+    """002's problem (smallest r_b over r_b and e): the batched finite-difference stencil changes nothing.
+
+    With ``batch`` each iterate is analysed together with its forward-difference
+    neighbours; the solver must take the very same path: the same optimum, constraints
+    and number of designs asked for, to the last digit.
+    """
+    from camcad.explore.optimize import Problem, optimize
+
+    data = sample_data("offset_roller")
+    variables = tuple(
+        parse_variable(t, data, flag="--vary", counted=False) for t in ("base_radius=20:120", "offset=0:40")
+    )
+    got = {
+        batch: optimize(
+            Problem(data=data, variables=variables, objectives=(MEASURES["base_radius"],), batch=batch)
+        )
+        for batch in (True, False)
+    }
+    assert repr(got[True]) == repr(got[False])
+    assert got[True].best is not None and got[True].best.values["base_radius"] == pytest.approx(
+        23.42, abs=0.01
+    )
