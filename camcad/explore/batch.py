@@ -370,41 +370,7 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
     def stacked_at(p: FloatArray, which: np.ndarray, side: Side) -> CamState:
         return group.state(group.motion(p, side), which)
 
-    # geometry: row v·8 + r is variant v's row r
-    kg = len(GEOMETRY_KINDS)
-    gvalues = geometry_rows(loop, stacked)  # (8, V·n)
-    gstack = gvalues.reshape(kg, nv, n).transpose(1, 0, 2).reshape(nv * kg, n)
-
-    def gquantity(p: FloatArray, side: Side) -> FloatArray:
-        m = p.size
-        st = stacked_at(np.tile(p, nv), np.repeat(np.arange(nv), m), side)
-        out: FloatArray = geometry_rows(loop, st).reshape(kg, nv, m).transpose(1, 0, 2).reshape(nv * kg, m)
-        return out
-
-    def gpick(p: FloatArray, rows: np.ndarray, side: Side) -> FloatArray:
-        st = stacked_at(p, rows // kg, side)
-        out: FloatArray = geometry_rows(loop, st)[rows % kg, np.arange(p.size)]
-        return out
-
-    gfound = extremes_stacked(
-        gquantity, gpick, group.phi, joints, GEOMETRY_KINDS * nv, values=gstack, rests=rests
-    )
-    answers: list[list[Answer]] = [
-        [
-            (
-                group.phi,
-                joints,
-                GEOMETRY_KINDS,
-                gstack[v * kg : (v + 1) * kg],
-                rests,
-                (),
-                gfound[v * kg : (v + 1) * kg],
-            )
-        ]
-        for v in range(nv)
-    ]
-
-    # dynamics: variants with equal setups share one model
+    # dynamics: variants with equal setups share one model; different ones, one model of stacked parameters
     setups = [
         replace(d.dynamics_setup(), drive_sign=sign, roller_radius=c.roller_radius)
         for d, c, sign in zip(group.designs, group.cams, group.drive_signs, strict=True)
@@ -424,7 +390,6 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
     owner = np.empty(nv, dtype=int)
     for g, (_, members) in enumerate(models):
         owner[members] = g
-
     stacked_setup = _Stacked.of(setups) if len(models) > 1 else None
 
     def drows(st: CamState, which: np.ndarray) -> FloatArray:
@@ -448,39 +413,53 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
                 )
         return out
 
-    got = drows(stacked, every)
-    dvalues = got.reshape(kd, nv, n).transpose(1, 0, 2).reshape(nv * kd, n)
+    # one search for both stages: variant v's rows are v·k … v·k + k − 1, its geometry's 8 then its
+    # dynamics' (each row's search is its own, so stacking them changes nothing but the number of calls)
+    kg = len(GEOMETRY_KINDS)
+    k = kg + kd
 
-    def dquantity(p: FloatArray, side: Side) -> FloatArray:
+    def both(st: CamState, which: np.ndarray) -> FloatArray:
+        """(k, m) every row at each angle, of the angle's own variant."""
+        return np.vstack((geometry_rows(loop, st), drows(st, which)))
+
+    def by_variant(values: FloatArray, m: int) -> FloatArray:
+        """(k, V·m) rows of the variants' angles in turn → (V·k, m), variant after variant."""
+        out: FloatArray = values.reshape(k, nv, m).transpose(1, 0, 2).reshape(nv * k, m)
+        return out
+
+    values = by_variant(both(stacked, every), n)
+
+    def quantity(p: FloatArray, side: Side) -> FloatArray:
         m = p.size
         which = np.repeat(np.arange(nv), m)
-        got = drows(stacked_at(np.tile(p, nv), which, side), which)
-        out: FloatArray = got.reshape(kd, nv, m).transpose(1, 0, 2).reshape(nv * kd, m)
+        return by_variant(both(stacked_at(np.tile(p, nv), which, side), which), m)
+
+    def pick(p: FloatArray, rows: np.ndarray, side: Side) -> FloatArray:
+        which = rows // k
+        out: FloatArray = both(stacked_at(p, which, side), which)[rows % k, np.arange(p.size)]
         return out
 
-    def dpick(p: FloatArray, rows: np.ndarray, side: Side) -> FloatArray:
-        which = rows // kd
-        out: FloatArray = drows(stacked_at(p, which, side), which)[rows % kd, np.arange(p.size)]
-        return out
-
-    settled_all: list[bool] = []
+    settled: list[bool] = []
     for v in range(nv):
-        settled_all += models[owner[v]][0][1][1]
-    dfound = extremes_stacked(
-        dquantity, dpick, group.phi, joints, kinds * nv, values=dvalues, rests=rests, settled=settled_all
+        settled += [False] * kg + list(models[owner[v]][0][1][1])
+    found = extremes_stacked(
+        quantity,
+        pick,
+        group.phi,
+        joints,
+        (GEOMETRY_KINDS + kinds) * nv,
+        values=values,
+        rests=rests,
+        settled=settled,
     )
+    answers: list[list[Answer]] = []
     for v in range(nv):
-        settled_v = models[owner[v]][0][1][1]
-        answers[v].append(
-            (
-                group.phi,
-                joints,
-                kinds,
-                dvalues[v * kd : (v + 1) * kd],
-                rests,
-                settled_v,
-                dfound[v * kd : (v + 1) * kd],
-            )
+        lo, mid, hi = v * k, v * k + kg, (v + 1) * k
+        answers.append(
+            [
+                (group.phi, joints, GEOMETRY_KINDS, values[lo:mid], rests, (), found[lo:mid]),
+                (group.phi, joints, kinds, values[mid:hi], rests, models[owner[v]][0][1][1], found[mid:hi]),
+            ]
         )
     return states, answers
 
