@@ -501,11 +501,12 @@ def _extremes(
     val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
     top = np.argmax(val, axis=1)
     best = val[np.arange(k), top]
+    twins: dict[int, int] = {}
     found = [
         Extreme(
             value=float(seq.value[r, top[r]]),
             phi=float(seq.phi[top[r]]),
-            side=_sample_side(seq, r, int(top[r])),
+            side=_sample_side(seq, r, int(top[r]), twins),
         )
         for r in range(k)
     ]
@@ -613,14 +614,25 @@ def minimum(
     return extremes(quantity, grid, joints, values=values, find=("min",))[0]
 
 
-def _sample_side(seq: _Sequence, row: int, k: int) -> Side | None:
-    """The side of sample k of a row: a left limit, or a right value where the left limit differs."""
+def _sample_side(seq: _Sequence, row: int, k: int, twins: dict[int, int] | None = None) -> Side | None:
+    """The side of sample k of a row: a left limit, or a right value where the left limit differs.
+
+    ``twins`` keeps each sample's twin (the other side at the same joint, −1
+    for none) across the rows of one search, which share the samples.
+    """
+    twin = -1 if twins is None else twins.get(k, -2)
+    if twin == -2 or twins is None:
+        if seq.left[k]:
+            found = np.flatnonzero((np.mod(seq.phi, TWO_PI) == seq.phi[k] % TWO_PI) & ~seq.left)
+        else:
+            found = np.flatnonzero((seq.phi == (TWO_PI if seq.phi[k] == 0.0 else seq.phi[k])) & seq.left)
+        twin = int(found[0]) if found.size else -1
+        if twins is not None:
+            twins[k] = twin
     value = seq.value[row]
     if seq.left[k]:
-        twin = np.flatnonzero((np.mod(seq.phi, TWO_PI) == seq.phi[k] % TWO_PI) & ~seq.left)
-        return None if twin.size and _same(value[twin[0]], value[k]) else "left"
-    twin = np.flatnonzero((seq.phi == (TWO_PI if seq.phi[k] == 0.0 else seq.phi[k])) & seq.left)
-    return "right" if twin.size and not _same(value[twin[0]], value[k]) else None
+        return None if twin >= 0 and _same(value[twin], value[k]) else "left"
+    return "right" if twin >= 0 and not _same(value[twin], value[k]) else None
 
 
 def _same(x: float, y: float) -> bool:
