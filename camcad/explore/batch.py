@@ -81,7 +81,7 @@ def structure_key(design: Design) -> str | None:
     follower kind and the family: a plate cam without ``[vibration]`` (whose
     compensated lift would change the program) and not linear.
     """
-    from camcad.design.spec import CamStyle
+    from camcad.geometry.spec import CamStyle
 
     if design.vibration is not None or design.cam.style is not CamStyle.PLATE:
         return None
@@ -139,7 +139,7 @@ class _FollowerStack:
 
     def at(self, which: np.ndarray) -> Any:
         """The stacked follower for angles of the variants ``which`` (one index per angle)."""
-        view = self.view_class.__new__(self.view_class)
+        view: Any = object.__new__(self.view_class)
         view.__dict__.update(self.constant)
         for name, values in self.varying.items():
             setattr(view, name, values[which])
