@@ -295,9 +295,12 @@ class _Group:
 
 
 def _group(designs: list[Design]) -> _Group:
-    from camcad.geometry.cam import Cam
+    from camcad.geometry.cam import Cam, follower_from_spec
     from camcad.geometry.families import family_of
 
+    # the followers first: a group whose followers cannot be stacked (an arm's pivot that moves) is
+    # refused before anything else is built
+    _FollowerStack([follower_from_spec(d.follower, d.cam.base_radius) for d in designs])
     first = Cam.from_design(designs[0])
     cams = [first] + [replace(Cam.from_design(d), program=first.program) for d in designs[1:]]
     signs = []
@@ -357,6 +360,7 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
     from camcad.dynamics.model import dynamics_rows, extreme_rows
     from camcad.extremes import extremes_stacked
     from camcad.geometry.cam import Cam
+    from camcad.geometry.envelope import keep_turn
     from camcad.geometry.limits import GEOMETRY_KINDS, geometry_rows
 
     nv, n = group.size, group.phi.size
@@ -364,7 +368,12 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
     joints = np.array([bp.phi for bp in group.cams[0].program.breakpoints], dtype=float)
     rests = group.cams[0].rests
     every = np.repeat(np.arange(nv), n)
-    stacked = group.state(_tile(group.grid_motion, nv), every)
+    tiled = _tile(group.grid_motion, nv)
+    for sigma in (group.sigma, -group.sigma):  # the grid's turn, once for all the variants
+        keep_turn(
+            tiled.phi, sigma, np.tile(np.cos(sigma * group.phi), nv), np.tile(np.sin(sigma * group.phi), nv)
+        )
+    stacked = group.state(tiled, every)
     states = [_state_slice(stacked, v * n, (v + 1) * n) for v in range(nv)]
 
     def stacked_at(p: FloatArray, which: np.ndarray, side: Side) -> CamState:

@@ -30,6 +30,7 @@ __all__ = [
     "Guide",
     "LineElement",
     "PointElement",
+    "keep_turn",
     "line_envelope",
     "offset_curve",
     "point_envelope",
@@ -67,6 +68,18 @@ def _turn(phi: FloatArray, sigma: float) -> tuple[FloatArray, FloatArray]:
         _TURNS.clear()
     _TURNS[key] = (weakref.ref(phi), c, s)
     return c, s
+
+
+def keep_turn(phi: FloatArray, sigma: float, cos: FloatArray, sin: FloatArray) -> None:
+    """Hand :func:`to_cam` the cos σφ and sin σφ of a read-only angle array computed elsewhere.
+
+    For a batch that stacks one sample grid many times (:mod:`camcad.explore.batch`):
+    the grid's cos and sin, tiled, are the stacked array's, value for value.
+    """
+    if phi.size >= _TURNS_MIN and not phi.flags.writeable:
+        if len(_TURNS) >= _TURNS_KEPT:
+            _TURNS.clear()
+        _TURNS[(id(phi), sigma)] = (weakref.ref(phi), cos, sin)
 
 
 def to_cam(phi: FloatArray, vectors: FloatArray, sigma: float) -> FloatArray:
