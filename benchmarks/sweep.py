@@ -14,12 +14,14 @@ LocalCluster. The machine's load average is printed too:
 on a shared machine the figures move with it.
 
 First, the batch analysis (issue 38, :mod:`camcad.explore.batch`) against the
-per-design path, in one run: for every shipped plate-cam sample, 32 variants
-of its base radius (r_b to 1.25·r_b) in chunks of 16, each chunk's rows
-computed with batching off (each variant analysed alone, as before issue 38)
-and on, CPU time of this process (``time.process_time``, the best of
-``--repeats`` alternating runs), the rows checked identical. The ratio is
-designs per CPU-second batched over one at a time.
+per-design path, in one run: for every shipped plate-cam sample, a sweep of 64
+variants of its base radius (r_b to 1.25·r_b, chunks of 16 as ``camcad
+sweep`` makes them) run as ``camcad sweep --jobs 1`` does
+(:func:`camcad.explore.run_sweep`), with batching off (each variant analysed
+alone) and on (the chunks packed up to 64 designs per batch); CPU time of
+this process (``time.process_time``, the best of ``--repeats`` alternating
+runs); the rows checked identical. The ratio is designs per CPU-second
+batched over one at a time.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from camcad.explore import MEASURES, SweepPlan, grid_points, parse_variable  # noqa: E402
-from camcad.explore.sweep import evaluate_chunk  # noqa: E402
+from camcad.explore.sweep import evaluate_chunk, run_sweep  # noqa: E402
 
 SAMPLE = ROOT / "samples" / "offset_roller.toml"
 
@@ -80,7 +82,7 @@ BATCH_SAMPLES = (
 """The shipped plate cams without ``[vibration]`` (a groove, a pair, a linear cam: one by one)."""
 
 
-def batch_plan(name: str, designs: int = 32, chunk: int = 16) -> SweepPlan:
+def batch_plan(name: str, designs: int = 64, chunk: int = 16) -> SweepPlan:
     path = ROOT / "samples" / f"{name}.toml"
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     r = float(data["cam"]["base_radius"])
@@ -113,9 +115,9 @@ def batch_table(repeats: int) -> None:
         chunks = p.chunks()
         n = len(p.points)
 
-        def run(batch: bool, chunks=chunks) -> tuple[float, list]:
+        def run(batch: bool, p=p) -> tuple[float, list]:
             start = time.process_time()
-            rows = [row for c in chunks for row in evaluate_chunk(replace(c, batch=batch))]
+            rows = run_sweep(replace(p, batch=batch))  # `camcad sweep --jobs 1`
             return time.process_time() - start, rows
 
         run(True)  # imports, caches
