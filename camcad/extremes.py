@@ -674,14 +674,19 @@ class _Answers:
                 a.kinds == tuple(kinds)
                 and a.rests == tuple(tuple(r) for r in rests)
                 and a.settled == tuple(bool(x) for x in settled)
-                and np.array_equal(a.grid, np.asarray(grid, dtype=float))
-                and np.array_equal(a.joints, np.asarray(joints, dtype=float).ravel())
-                and np.array_equal(a.values, _rows(values, len(kinds)), equal_nan=True)
+                and _same_bits(a.grid, np.asarray(grid, dtype=float))
+                and _same_bits(a.joints, np.asarray(joints, dtype=float).ravel())
+                and _same_bits(a.values, _rows(values, len(kinds)))
             ):
                 del self.left[i]
                 self.used += 1
                 return a.found
         return None
+
+
+def _same_bits(a: FloatArray, b: FloatArray) -> bool:
+    """Whether two arrays hold the same numbers bit for bit (−0.0 is not 0.0, NaN is NaN)."""
+    return a.shape == b.shape and np.ascontiguousarray(a).tobytes() == np.ascontiguousarray(b).tobytes()
 
 
 _SERVED: ContextVar[_Answers | None] = ContextVar("camcad_extremes_served", default=None)
@@ -729,7 +734,7 @@ def served(
     Each answer is (grid, joints, kinds, values, rests, settled, extremes),
     found ahead by :func:`extremes_stacked` for many analyses at once. A call
     takes an answer only when its grid, joints, kinds, rests, settled rows
-    and sampled values are exactly the answer's (the values decide the
+    and sampled values are exactly the answer's, bit for bit (the values decide the
     search, the quantity being the one the answer was found on), and each
     answer once; any other call searches as usual. The yielded object's
     ``used`` counts the answers taken.

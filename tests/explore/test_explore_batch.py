@@ -260,3 +260,69 @@ def test_optimize_same_result_with_batched_gradients() -> None:
     assert got[True].best is not None and got[True].best.values["base_radius"] == pytest.approx(
         23.42, abs=0.01
     )
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    coef=st.lists(
+        st.tuples(
+            st.floats(min_value=-3, max_value=3), st.floats(min_value=0.5, max_value=4), st.floats(-3, 3)
+        ),
+        min_size=1,
+        max_size=5,
+    )
+)
+def test_stacked_search_equals_each_row_alone(coef) -> None:
+    """Rows a·sin(b·φ + c) jumping at a joint: one stacked search gives each row's own, bit for bit."""
+    from camcad.extremes import extremes_rows, extremes_stacked
+
+    joints = [1.0, 4.0]
+
+    def f(i: int, p: np.ndarray, side: str) -> np.ndarray:
+        a, b, c = coef[i]
+        jump = np.where((p > 1.0) | ((p == 1.0) & (side == "right")), 0.3 * a, 0.0)
+        return a * np.sin(b * p + c) + jump
+
+    grid = np.linspace(0.0, 2 * math.pi, 361, endpoint=False)
+    kinds = ("max", "min")
+    alone = [
+        extremes_rows(lambda p, side, i=i: np.vstack((f(i, p, side), f(i, p, side))), grid, joints, kinds)
+        for i in range(len(coef))
+    ]
+
+    def quantity(p, side):
+        return np.vstack([np.vstack((f(i, p, side), f(i, p, side))) for i in range(len(coef))])
+
+    def pick(p, rows, side):
+        out = np.empty(p.size)
+        for i in range(len(coef)):
+            mine = rows // 2 == i
+            out[mine] = f(i, p[mine], side)
+        return out
+
+    stacked = extremes_stacked(quantity, pick, grid, joints, kinds * len(coef))
+    assert [repr(e) for pair in alone for e in pair] == [repr(e) for e in stacked]
+
+
+def test_served_answers_only_the_same_bits() -> None:
+    """A search done ahead answers the call with its very samples; a −0.0 for a 0.0 is searched anew."""
+    from camcad.extremes import Extreme, extremes_rows, served
+
+    grid = np.linspace(0.0, 2 * math.pi, 90, endpoint=False)
+    values = np.vstack((np.cos(grid), np.cos(grid)))
+    values[:, 10] = 0.0
+
+    def rows(p, side):
+        return np.vstack((np.cos(p), np.cos(p)))
+
+    marker = (Extreme(value=42.0, phi=0.0), Extreme(value=-42.0, phi=0.0))
+    answer = (grid, np.array([0.0]), ("max", "min"), values, (), (), marker)
+    with served([answer]) as held:
+        assert extremes_rows(rows, grid, [0.0], ("max", "min"), values=values) == marker
+        assert held.used == 1
+    flipped = values.copy()
+    flipped[:, 10] = -0.0
+    with served([answer]) as held:
+        got = extremes_rows(rows, grid, [0.0], ("max", "min"), values=flipped)
+        assert got != marker and held.used == 0
+        assert got[0].value == pytest.approx(1.0) and got[1].value == pytest.approx(-1.0)
