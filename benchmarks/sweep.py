@@ -82,13 +82,15 @@ BATCH_SAMPLES = (
 """The shipped plate cams without ``[vibration]`` (a groove, a pair, a linear cam: one by one)."""
 
 
-def batch_plan(name: str, designs: int = 64, chunk: int = 16) -> SweepPlan:
+SPEED_SAMPLES = ("packaging_rocker", "rocker_flat")
+"""The arms, whose pivot moves with the base radius (one at a time there): swept in speed instead."""
+
+
+def batch_plan(name: str, designs: int = 64, chunk: int = 16, key: str = "base_radius") -> SweepPlan:
     path = ROOT / "samples" / f"{name}.toml"
     data = tomllib.loads(path.read_text(encoding="utf-8"))
-    r = float(data["cam"]["base_radius"])
-    variables = (
-        parse_variable(f"base_radius={r!r}:{1.25 * r!r}:{designs}", data, flag="--grid", counted=True),
-    )
+    r = float(data["cam"][key])
+    variables = (parse_variable(f"{key}={r!r}:{1.25 * r!r}:{designs}", data, flag="--grid", counted=True),)
     return SweepPlan(
         data=data,
         source=str(path),
@@ -99,7 +101,7 @@ def batch_plan(name: str, designs: int = 64, chunk: int = 16) -> SweepPlan:
     )
 
 
-def batch_table(repeats: int) -> None:
+def batch_table(repeats: int, samples: tuple[str, ...] = BATCH_SAMPLES, key: str = "base_radius") -> None:
     """Designs per CPU-second of this process, one at a time and batched, per sample; rows compared."""
     from dataclasses import replace
 
@@ -110,8 +112,8 @@ def batch_table(repeats: int) -> None:
     print("|---|---|---|---|---|---|---|---|")
     total_one = total_batch = 0.0
     count = 0
-    for name in BATCH_SAMPLES:
-        p = batch_plan(name)
+    for name in samples:
+        p = batch_plan(name, key=key)
         chunks = p.chunks()
         n = len(p.points)
 
@@ -143,8 +145,8 @@ def batch_table(repeats: int) -> None:
         total_batch += many
         count += n
     print(
-        f"\nAll samples: {count / total_one:.1f} designs per CPU-second one at a time, "
-        f"{count / total_batch:.1f} batched: **{total_one / total_batch:.2f}×**.\n"
+        f"\nAll {len(samples)} samples, {key} varied: {count / total_one:.1f} designs per CPU-second "
+        f"one at a time, {count / total_batch:.1f} batched: **{total_one / total_batch:.2f}×**.\n"
     )
 
 
@@ -163,7 +165,13 @@ def main() -> None:
     )
     parser.add_argument("--batch-only", action="store_true", help="only the batch table")
     args = parser.parse_args()
+    print(
+        "Batch analysis against one at a time, base radius varied (r_b to 1.25·r_b), "
+        f"{args.repeats} runs each:\n"
+    )
     batch_table(args.repeats)
+    print("The arms again, their speed varied (rpm to 1.25·rpm; their pivot stays put):\n")
+    batch_table(args.repeats, SPEED_SAMPLES, key="speed_rpm")
     if args.batch_only:
         return
     p = plan(args.designs, args.chunk)
