@@ -78,14 +78,15 @@ def structure_key(design: Design) -> str | None:
     """What variants must share to be analysed together; None for a design analysed one by one.
 
     The motion program's segments, the rotation, the sample step, the
-    follower kind and the family: a plate cam without ``[vibration]`` (whose
-    compensated lift would change the program) and not linear.
+    follower kind and the cam style; a design with ``[vibration]`` (whose
+    compensated lift would change the program) is analysed alone. A family
+    of more than one part (a conjugate pair) or an open profile (a linear
+    cam) is found out when the group is built, and analysed one by one.
     """
-    from camcad.geometry.spec import CamStyle
-
-    if design.vibration is not None or design.cam.style is not CamStyle.PLATE:
+    if design.vibration is not None:
         return None
-    return repr((design.motion, design.cam.rotation, design.cam.sample_step, design.follower.kind))
+    cam = design.cam
+    return repr((design.motion, cam.rotation, cam.sample_step, cam.style, design.follower.kind))
 
 
 class _Unsupported(Exception):

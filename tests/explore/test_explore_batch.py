@@ -54,7 +54,7 @@ def _mushroom() -> dict[str, Any]:
     return data
 
 
-# follower kind → (design mapping, the variables drawn, whether the batch must take the variants)
+# follower kind or family → (design mapping, the variables drawn, whether the batch must take the variants)
 KINDS: dict[str, tuple[Any, tuple[str, ...], bool]] = {
     "translating-roller": (
         lambda: sample_data("offset_roller"),
@@ -66,6 +66,11 @@ KINDS: dict[str, tuple[Any, tuple[str, ...], bool]] = {
     # an arm's pivot moves with the base radius (not stackable): spring, speed and mass are
     "oscillating-roller": (lambda: sample_data("packaging_rocker"), ("speed_rpm", "follower_mass"), True),
     "oscillating-flat": (lambda: sample_data("rocker_flat"), ("speed_rpm",), True),
+    # the families: a groove is one part (its flanks' loads and stresses among the searched rows); a
+    # conjugate pair has two plates and a linear cam an open profile: both analysed one by one
+    "groove": (lambda: sample_data("groove_rocker"), ("speed_rpm", "arm_inertia"), True),
+    "conjugate pair": (lambda: sample_data("indexing_conjugate"), ("speed_rpm",), False),
+    "linear cam": (lambda: sample_data("linear_cam"), ("speed_rpm",), False),
 }
 
 _SCALE = st.floats(min_value=0.85, max_value=1.25, allow_nan=False)
