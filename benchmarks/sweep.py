@@ -79,7 +79,7 @@ BATCH_SAMPLES = (
     "tolerance_roller",
     "web_cutter",
 )
-"""The shipped plate cams without ``[vibration]`` (a groove, a pair, a linear cam: one by one)."""
+"""The shipped plate cams without ``[vibration]`` (slides and arms; the groove, pair and linear cam aside)."""
 
 
 SPEED_SAMPLES = ("packaging_rocker", "rocker_flat")
