@@ -18,8 +18,10 @@ over brackets and one call of the quantity per evaluation.
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import Literal
 
@@ -39,8 +41,10 @@ __all__ = [
     "extremes",
     "extremes_each",
     "extremes_rows",
+    "extremes_stacked",
     "maximum",
     "minimum",
+    "served",
     "side_text",
 ]
 
@@ -165,7 +169,7 @@ def _sequence(
     order = np.lexsort((phi, np.concatenate((piece_grid, piece_left))))
     return _Sequence(
         phi=phi[order],
-        value=np.concatenate((right, left), axis=1)[:, order],
+        value=np.take(np.concatenate((right, left), axis=1), order, axis=1),
         piece=np.concatenate((piece_grid, piece_left))[order],
         left=np.concatenate((np.zeros(grid.size, bool), np.ones(left_phi.size, bool)))[order],
     )
@@ -200,15 +204,32 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
     same_prev[1:] = seq.piece[1:] == seq.piece[:-1]
     same_next = np.zeros(m, bool)
     same_next[:-1] = seq.piece[:-1] == seq.piece[1:]
-    prev_val = np.where(same_prev, np.roll(val, 1, axis=1), -np.inf)
-    next_val = np.where(same_next, np.roll(val, -1, axis=1), -np.inf)
+    # a finite sample at least its neighbours in its piece, not flat on both sides: compared on the whole
+    # array (a neighbour outside the piece counts as −inf), the rest only at these few candidates
     with np.errstate(invalid="ignore"):
-        peak = (val >= prev_val) & (val >= next_val) & np.isfinite(val)
-        flat = (~same_prev | (val == prev_val)) & (~same_next | (val == next_val))
-        lower = np.minimum(np.where(same_prev, prev_val, np.inf), np.where(same_next, next_val, np.inf))
-        drop = np.where(np.isfinite(lower), val - lower, np.inf)
-        promising = val + 4.0 * drop >= best[:, None]
-    rows, idx = np.nonzero(peak & ~flat & promising)
+        ge_prev, eq_prev = np.empty(val.shape, bool), np.empty(val.shape, bool)
+        ge_next, eq_next = np.empty(val.shape, bool), np.empty(val.shape, bool)
+        np.greater_equal(val[:, 1:], val[:, :-1], out=ge_prev[:, 1:])
+        np.equal(val[:, 1:], val[:, :-1], out=eq_prev[:, 1:])
+        np.greater_equal(val[:, :-1], val[:, 1:], out=ge_next[:, :-1])
+        np.equal(val[:, :-1], val[:, 1:], out=eq_next[:, :-1])
+        outside_prev, outside_next = np.flatnonzero(~same_prev), np.flatnonzero(~same_next)
+        ge_prev[:, outside_prev] = eq_prev[:, outside_prev] = True  # no neighbour before a piece's start
+        ge_next[:, outside_next] = eq_next[:, outside_next] = True  # nor after its end
+        np.logical_and(ge_prev, ge_next, out=ge_prev)
+        np.logical_and(ge_prev, np.isfinite(val), out=ge_prev)  # a peak
+        np.logical_and(eq_prev, eq_next, out=eq_prev)  # flat on both sides
+        np.logical_and(ge_prev, ~eq_prev, out=ge_prev)
+        rows, idx = np.nonzero(ge_prev)
+        here = val[rows, idx]
+        prev_val = np.where(same_prev[idx], val[rows, idx - 1], -np.inf)
+        next_val = np.where(same_next[idx], val[rows, (idx + 1) % m], -np.inf)
+        lower = np.minimum(
+            np.where(same_prev[idx], prev_val, np.inf), np.where(same_next[idx], next_val, np.inf)
+        )
+        drop = np.where(np.isfinite(lower), here - lower, np.inf)
+        promising = here + 4.0 * drop >= best[rows]
+    rows, idx = rows[promising], idx[promising]
     inner = same_prev[idx] & same_next[idx]
     out_rows, x1, x2, x3, f1, f2, f3 = [], [], [], [], [], [], []
     r, i = rows[inner], idx[inner]
@@ -462,6 +483,11 @@ def _extremes(
     settled: Sequence[bool] = (),
 ) -> tuple[Extreme, ...]:
     """:func:`extremes_rows` with ``quantity`` for whole rows and ``pick`` for one row per angle."""
+    answers = _SERVED.get()
+    if answers is not None and values is not None:
+        got = answers.take(grid, joints, kinds, values, rests, settled)
+        if got is not None:
+            return got
     k = len(kinds)
     grid_a = np.asarray(grid, dtype=float)
     seq = _sequence(
@@ -475,11 +501,12 @@ def _extremes(
     val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
     top = np.argmax(val, axis=1)
     best = val[np.arange(k), top]
+    twins: dict[int, int] = {}
     found = [
         Extreme(
             value=float(seq.value[r, top[r]]),
             phi=float(seq.phi[top[r]]),
-            side=_sample_side(seq, r, int(top[r])),
+            side=_sample_side(seq, r, int(top[r]), twins),
         )
         for r in range(k)
     ]
@@ -491,8 +518,12 @@ def _extremes(
     br = _probe_end_gaps(picker, br)
     if br.x1.size:
         phi_best, f_best = _refine_max(_Picker(pick, sign[:, 0], br.row), br)
-        for r in range(k):
-            mine = np.flatnonzero(br.row == r)
+        by_row = np.argsort(br.row, kind="stable")  # each row's brackets together, in their order
+        rows_sorted = br.row[by_row]
+        starts = np.flatnonzero(np.r_[True, rows_sorted[1:] != rows_sorted[:-1]])
+        for lo, hi in zip(starts.tolist(), [*starts[1:].tolist(), by_row.size], strict=True):
+            r = int(rows_sorted[lo])
+            mine = by_row[lo:hi]
             if mine.size:
                 i = mine[int(np.argmax(f_best[mine]))]
                 # a gain within round-off (a flat stretch, say a dwell) keeps the sample
@@ -583,16 +614,147 @@ def minimum(
     return extremes(quantity, grid, joints, values=values, find=("min",))[0]
 
 
-def _sample_side(seq: _Sequence, row: int, k: int) -> Side | None:
-    """The side of sample k of a row: a left limit, or a right value where the left limit differs."""
+def _sample_side(seq: _Sequence, row: int, k: int, twins: dict[int, int] | None = None) -> Side | None:
+    """The side of sample k of a row: a left limit, or a right value where the left limit differs.
+
+    ``twins`` keeps each sample's twin (the other side at the same joint, −1
+    for none) across the rows of one search, which share the samples.
+    """
+    twin = -1 if twins is None else twins.get(k, -2)
+    if twin == -2 or twins is None:
+        if seq.left[k]:
+            found = np.flatnonzero((np.mod(seq.phi, TWO_PI) == seq.phi[k] % TWO_PI) & ~seq.left)
+        else:
+            found = np.flatnonzero((seq.phi == (TWO_PI if seq.phi[k] == 0.0 else seq.phi[k])) & seq.left)
+        twin = int(found[0]) if found.size else -1
+        if twins is not None:
+            twins[k] = twin
     value = seq.value[row]
     if seq.left[k]:
-        twin = np.flatnonzero((np.mod(seq.phi, TWO_PI) == seq.phi[k] % TWO_PI) & ~seq.left)
-        return None if twin.size and _same(value[twin[0]], value[k]) else "left"
-    twin = np.flatnonzero((seq.phi == (TWO_PI if seq.phi[k] == 0.0 else seq.phi[k])) & seq.left)
-    return "right" if twin.size and not _same(value[twin[0]], value[k]) else None
+        return None if twin >= 0 and _same(value[twin], value[k]) else "left"
+    return "right" if twin >= 0 and not _same(value[twin], value[k]) else None
 
 
 def _same(x: float, y: float) -> bool:
     """Whether two one-sided limits agree to round-off (the quantity is continuous there)."""
     return bool(x == y or abs(x - y) <= _CONTINUOUS_RTOL * max(abs(x), abs(y)))
+
+
+@dataclass(frozen=True, slots=True)
+class _Answer:
+    """One search done ahead (see :func:`served`): its inputs, which must match, and its extremes."""
+
+    grid: FloatArray
+    joints: FloatArray
+    kinds: tuple[Kind, ...]
+    values: FloatArray
+    rests: tuple[tuple[float, float], ...]
+    settled: tuple[bool, ...]
+    found: tuple[Extreme, ...]
+
+
+class _Answers:
+    """Searches done ahead for one analysis, each given once to the call with exactly its inputs."""
+
+    def __init__(self, answers: Sequence[_Answer]) -> None:
+        self.left = list(answers)
+        self.used = 0
+
+    def take(
+        self,
+        grid: ArrayLike,
+        joints: Sequence[float] | ArrayLike,
+        kinds: Sequence[Kind],
+        values: ArrayLike,
+        rests: Sequence[tuple[float, float]],
+        settled: Sequence[bool],
+    ) -> tuple[Extreme, ...] | None:
+        for i, a in enumerate(self.left):
+            if (
+                a.kinds == tuple(kinds)
+                and a.rests == tuple(tuple(r) for r in rests)
+                and a.settled == tuple(bool(x) for x in settled)
+                and _same_bits(a.grid, np.asarray(grid, dtype=float))
+                and _same_bits(a.joints, np.asarray(joints, dtype=float).ravel())
+                and _same_bits(a.values, _rows(values, len(kinds)))
+            ):
+                del self.left[i]
+                self.used += 1
+                return a.found
+        return None
+
+
+def _same_bits(a: FloatArray, b: FloatArray) -> bool:
+    """Whether two arrays hold the same numbers bit for bit (−0.0 is not 0.0, NaN is NaN)."""
+    return a.shape == b.shape and np.ascontiguousarray(a).tobytes() == np.ascontiguousarray(b).tobytes()
+
+
+_SERVED: ContextVar[_Answers | None] = ContextVar("camcad_extremes_served", default=None)
+
+
+def extremes_stacked(
+    quantity: Rows,
+    pick: RowPick,
+    grid: ArrayLike,
+    joints: Sequence[float] | ArrayLike,
+    kinds: Sequence[Kind],
+    *,
+    values: ArrayLike | None = None,
+    rests: Sequence[tuple[float, float]] = (),
+    settled: Sequence[bool] = (),
+) -> tuple[Extreme, ...]:
+    """:func:`extremes_rows` for many independent rows: ``quantity`` for all rows, ``pick`` for one each.
+
+    The search of every row is the one :func:`extremes_rows` does for it
+    alone: its samples, its brackets and the vectorised refinement are
+    elementwise per row and per bracket, so stacking the rows of many
+    analyses (a batch of design variants, :mod:`camcad.explore.batch`)
+    changes no bit of any row's result, only how many calls the quantity
+    takes.
+    """
+    return _extremes(quantity, pick, grid, joints, kinds, values, rests=rests, settled=settled)
+
+
+@contextlib.contextmanager
+def served(
+    answers: Sequence[
+        tuple[
+            FloatArray,
+            FloatArray,
+            Sequence[Kind],
+            FloatArray,
+            Sequence[tuple[float, float]],
+            Sequence[bool],
+            tuple[Extreme, ...],
+        ]
+    ],
+) -> Iterator[_Answers]:
+    """Within the block, a search whose inputs equal one of ``answers`` returns that answer's extremes.
+
+    Each answer is (grid, joints, kinds, values, rests, settled, extremes),
+    found ahead by :func:`extremes_stacked` for many analyses at once. A call
+    takes an answer only when its grid, joints, kinds, rests, settled rows
+    and sampled values are exactly the answer's, bit for bit (the values decide the
+    search, the quantity being the one the answer was found on), and each
+    answer once; any other call searches as usual. The yielded object's
+    ``used`` counts the answers taken.
+    """
+    held = _Answers(
+        [
+            _Answer(
+                grid=np.asarray(g, dtype=float),
+                joints=np.asarray(j, dtype=float).ravel(),
+                kinds=tuple(k),
+                values=_rows(v, len(k)),
+                rests=tuple(tuple(r) for r in rs),  # type: ignore[misc]
+                settled=tuple(bool(x) for x in st),
+                found=found,
+            )
+            for g, j, k, v, rs, st, found in answers
+        ]
+    )
+    token = _SERVED.set(held)
+    try:
+        yield held
+    finally:
+        _SERVED.reset(token)

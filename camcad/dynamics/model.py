@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
     from camcad.motion.program import Motion
 
-__all__ = ["analyse_dynamics", "contact_stress_at"]
+__all__ = ["DynamicsRows", "analyse_dynamics", "contact_stress_at", "dynamics_rows", "extreme_rows"]
 
 _RAD_S_TO_RPM = 60.0 / (2.0 * math.pi)
 # the extremes analyse_dynamics reports, one per row of its quantity
@@ -485,12 +485,7 @@ def _extremes(
     kinds = _KINDS + _FLANK_KINDS if flanks else _KINDS
 
     def rows(r: _Pointwise) -> FloatArray:
-        out = _reported(r, margin=margin, omega=omega, preload=preload)
-        if flanks:  # load and stress of the flank that drives: the inner one where F > 0
-            inner = r.force > 0.0
-            on_inner, on_outer = np.where(inner, r.stress, 0.0), np.where(inner, 0.0, r.stress)
-            out = np.vstack((out, np.maximum(r.force, 0.0), np.maximum(-r.force, 0.0), on_inner, on_outer))
-        return out
+        return _rows_of(r, margin=margin, omega=omega, preload=preload, flanks=flanks)
 
     values = rows(sampled)
     if cam is None:
@@ -504,6 +499,50 @@ def _extremes(
     joints = [bp.phi for bp in cam.program.breakpoints]
     settled = [unloaded and margin == 0.0 and k in _SPEED_BOUND_ROWS for k in range(len(kinds))]
     return extremes_rows(quantity, phi, joints, kinds, values=values, rests=cam.rests, settled=settled)
+
+
+def _rows_of(r: _Pointwise, *, margin: float, omega: float, preload: float, flanks: bool) -> FloatArray:
+    """The rows whose extremes :func:`analyse_dynamics` reports (``_KINDS``, a groove's ``_FLANK_KINDS``)."""
+    out = _reported(r, margin=margin, omega=omega, preload=preload)
+    if flanks:  # load and stress of the flank that drives: the inner one where F > 0
+        inner = r.force > 0.0
+        on_inner, on_outer = np.where(inner, r.stress, 0.0), np.where(inner, 0.0, r.stress)
+        out = np.vstack((out, np.maximum(r.force, 0.0), np.maximum(-r.force, 0.0), on_inner, on_outer))
+    return out
+
+
+DynamicsRows = Callable[["Motion", FloatArray, FloatArray, "FloatArray | None"], FloatArray]
+"""(motion, α [rad], profile ρ [mm], lever [mm] or None) at n angles → (k, n) rows."""
+
+
+def extreme_rows(setup: DynamicsSetup) -> tuple[tuple[Kind, ...], tuple[bool, ...], DynamicsRows]:
+    """What :func:`analyse_dynamics` refines with an exact cam: each row's kind, its settled flag, the rows.
+
+    The rows are the same function of the model's pointwise inputs as in
+    :func:`analyse_dynamics` (contact force, torque, stress, the preload
+    need and the speed bounds; a groove's flank loads and stresses), so a
+    batch of design variants (:mod:`camcad.explore.batch`) can search their
+    extremes together and hand each analysis its own
+    (:func:`camcad.extremes.served`).
+    """
+    margin = setup.spec.min_contact_force
+    kinds = _KINDS + _FLANK_KINDS if setup.flank_offsets is not None else _KINDS
+    unloaded = _load(setup).unloaded
+    settled = tuple(unloaded and margin == 0.0 and k in _SPEED_BOUND_ROWS for k in range(len(kinds)))
+    return kinds, settled, dynamics_rows(setup)
+
+
+def dynamics_rows(setup: DynamicsSetup) -> DynamicsRows:
+    """The rows of :func:`extreme_rows` alone (no kinds, no settled flags); see there."""
+    model = _model(setup)
+    margin, omega, preload = setup.spec.min_contact_force, setup.omega, _preload(setup)
+    flanks = setup.flank_offsets is not None
+
+    def rows(motion: Motion, alpha: FloatArray, rho: FloatArray, lever: FloatArray | None) -> FloatArray:
+        r = model(motion, alpha, rho, lever)
+        return _rows_of(r, margin=margin, omega=omega, preload=preload, flanks=flanks)
+
+    return rows
 
 
 def _findings(

@@ -108,6 +108,7 @@ class Problem:
     starts: int = 1  # the design's own values, then Latin-hypercube starts
     points: int = 7  # points of a two-objective front
     seed: int = 0
+    batch: bool = True  # analyse each iterate with its finite-difference neighbours together (same numbers)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -325,6 +326,7 @@ class _Evaluator:
         self.free = [v for v in problem.variables if v.continuous]
         self.limits = list(limits)
         self.cache: dict[tuple[float, ...], _Point] = {}
+        self.asked: set[tuple[float, ...]] = set()
 
     def physical(self, x: np.ndarray) -> tuple[float, ...]:
         """Scaled [0, 1] values → the variables' values in the design file's units."""
@@ -339,16 +341,51 @@ class _Evaluator:
         return [v for v, _ in self.fixed] + self.free, [c for _, c in self.fixed] + list(physical)
 
     def __call__(self, x: np.ndarray) -> _Point:
-        return self.at(self.physical(x))
+        key = self.physical(x)
+        if key not in self.cache and self.free and self.problem.batch:
+            self._prefetch(np.asarray(x, dtype=float))
+        return self.at(key)
+
+    def _prefetch(self, x: np.ndarray) -> None:
+        """Analyse ``x`` and its forward-difference neighbours together, as one batch.
+
+        The solver asks for f and g at x and then, for its finite-difference
+        gradient, at x + h·e_i (h = :data:`_FD_STEP`, −h where x + h leaves
+        [0, 1]); those designs share x's motion structure, so they are
+        analysed at once (:func:`camcad.explore.batch.analyse_many`, the same
+        analyses to the bit) and kept. A neighbour the solver does not ask
+        for costs a fraction of one analysis.
+        """
+        from camcad.explore.batch import analyse_many
+
+        stencil = [x]
+        for i in range(x.size):
+            z = x.copy()
+            step = _FD_STEP if x[i] + _FD_STEP <= 1.0 else -_FD_STEP
+            z[i] = x[i] + step
+            stencil.append(z)
+        keys = list(dict.fromkeys(k for k in (self.physical(z) for z in stencil) if k not in self.cache))
+        designs: list[tuple[tuple[float, ...], Any]] = []
+        for key in keys:
+            variables, values = self.values_at(key)
+            try:
+                designs.append(
+                    (key, design_with(self.problem.data, variables, values, source=self.problem.source))
+                )
+            except CamcadError as err:
+                self.cache[key] = _invalid(err)
+        analysed = analyse_many([d for _, d in designs])
+        for (key, design), got in zip(designs, analysed, strict=True):
+            self.cache[key] = _invalid(got) if isinstance(got, CamcadError) else self._point(design, got)
 
     def at(self, physical: tuple[float, ...]) -> _Point:
         """The analysed variant with the continuous variables at ``physical`` (design-file units)."""
+        self.asked.add(physical)  # the designs the search asked for (not those analysed ahead)
         if physical not in self.cache:
             self.cache[physical] = self._evaluate(physical)
         return self.cache[physical]
 
     def _evaluate(self, physical: tuple[float, ...]) -> _Point:
-        from camcad.geometry.sizing import feasible_margins
         from camcad.pipeline import analyse
 
         variables, values = self.values_at(physical)
@@ -356,7 +393,13 @@ class _Evaluator:
             design = design_with(self.problem.data, variables, values, source=self.problem.source)
             analysis = analyse(design, fit=False, toolpath=False, strict=False)
         except CamcadError as err:
-            return _Point({}, {}, -math.inf, 1.0, (str(err),), False)
+            return _invalid(err)
+        return self._point(design, analysis)
+
+    def _point(self, design: Any, analysis: Any) -> _Point:
+        """The solver's view of an analysed variant: measures, pieces, the curvature margin, findings."""
+        from camcad.geometry.sizing import feasible_margins
+
         summary = analysis.summary()
         measures = measure_values(analysis, summary)
         plates = [(r.part.cam, r.geometry.phi) for r in analysis.parts]  # every part: a pair's second plate
@@ -379,6 +422,11 @@ class _Evaluator:
         rho_margin = min([rho_margin, *(c.radius_margin for r in analysis.parts for c in r.part.checks)])
         findings = tuple(f.message for f in analysis.findings if not f.note)
         return _Point(measures, pieces, float(rho_margin), max(design.cam.base_radius, 1.0), findings, True)
+
+
+def _invalid(err: CamcadError) -> _Point:
+    """A variant the schema or a stage refused: no figures, its message."""
+    return _Point({}, {}, -math.inf, 1.0, (str(err),), False)
 
 
 def _signed_pressure_deg(cam: Any, phi: np.ndarray) -> tuple[float, float]:
@@ -508,7 +556,7 @@ def _candidate(
         # every limit holds and the analysis found none broken: `camcad check`'s verdict
         feasible=point.valid and bool(np.all(margins >= 0.0)) and not point.findings,
         data=apply_values(ev.problem.data, variables, values),
-        evaluations=len(ev.cache),
+        evaluations=len(ev.asked),
         message=message,
         findings=point.findings,
     )
@@ -657,7 +705,7 @@ def optimize(problem: Problem, *, progress: Callable[[str], None] | None = None)
         everything.append(best)
         if len(problem.objectives) == 2:
             everything += _front(ev, problem, best, starts, limits)
-        evaluations += len(ev.cache)
+        evaluations += len(ev.asked)
     if len(problem.objectives) == 1:
         best_all: Candidate | None = None
         for cand in tried:

@@ -20,7 +20,7 @@ from camcad.explore.space import Variable
 __all__ = ["DEFAULT_CHUNK", "Chunk", "SweepPlan"]
 
 DEFAULT_CHUNK = 16
-"""Designs per chunk: a few seconds of work for one worker (one analysis takes 30–100 ms)."""
+"""Designs per chunk: about a second of work for a worker (an analysis: 20–100 ms alone, 4–10 ms batched)."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -41,6 +41,7 @@ class SweepPlan:
     pareto: tuple[Measure, Measure]
     sampling: str = "grid"
     chunk_size: int = DEFAULT_CHUNK
+    batch: bool = True  # analyse a chunk's variants together (camcad.explore.batch): the same rows, faster
 
     def key(self) -> str:
         """A hash of everything that decides the rows (and of camcad's version)."""
@@ -69,6 +70,7 @@ class SweepPlan:
                 limits=self.limits,
                 start=start,
                 points=self.points[start : start + n],
+                batch=self.batch,
             )
             for start in range(0, len(self.points), n)
         ]
@@ -84,3 +86,4 @@ class Chunk:
     limits: tuple[Limit, ...]
     start: int
     points: tuple[tuple[Any, ...], ...]
+    batch: bool = True

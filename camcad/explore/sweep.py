@@ -47,9 +47,11 @@ from camcad.explore.table import csv_text, parquet_bytes
 
 __all__ = [
     "FORMATS",
+    "PACK",
     "SweepPlan",
     "SweepResult",
     "evaluate_chunk",
+    "evaluate_chunks",
     "evaluate_point",
     "run_sweep",
     "sweep",
@@ -98,12 +100,67 @@ def evaluate_point(
 
 
 def evaluate_chunk(chunk: Chunk) -> list[dict[str, Any]]:
-    """The rows of one chunk, each with its ``index`` in the sweep (what a worker runs)."""
+    """The rows of one chunk, each with its ``index`` in the sweep (what a worker runs).
+
+    With ``chunk.batch`` the chunk's variants that share one motion structure
+    are analysed together (:mod:`camcad.explore.batch`), the others one by
+    one (:func:`evaluate_point`); the rows are the same bytes either way.
+    """
+    if chunk.batch:
+        from camcad.explore.batch import chunk_rows
+
+        rows = chunk_rows(chunk.data, chunk.variables, chunk.points, limits=chunk.limits, source=chunk.source)
+        return [{"index": chunk.start + i} | row for i, row in enumerate(rows)]
     return [
         {"index": chunk.start + i}
         | evaluate_point(chunk.data, chunk.variables, values, limits=chunk.limits, source=chunk.source)
         for i, values in enumerate(chunk.points)
     ]
+
+
+PACK = 64
+"""Most designs analysed in one batch: a process evaluates consecutive chunks together up to this many."""
+
+
+def evaluate_chunks(chunks: Sequence[Chunk]) -> list[list[dict[str, Any]]]:
+    """The rows of consecutive chunks of one plan, their variants analysed in one batch.
+
+    The rows are each chunk's :func:`evaluate_chunk` rows (the batch analysis
+    gives every design the bytes of its analysis alone, however the designs
+    are grouped); a bigger batch only spreads its fixed cost over more designs.
+    """
+    if not chunks:
+        return []
+    first = chunks[0]
+    if len(chunks) == 1 or not first.batch:
+        return [evaluate_chunk(c) for c in chunks]
+    from camcad.explore.batch import chunk_rows
+
+    points = [p for c in chunks for p in c.points]
+    rows = chunk_rows(first.data, first.variables, points, limits=first.limits, source=first.source)
+    out: list[list[dict[str, Any]]] = []
+    at = 0
+    for c in chunks:
+        out.append([{"index": c.start + i} | row for i, row in enumerate(rows[at : at + len(c.points)])])
+        at += len(c.points)
+    return out
+
+
+def _packs(chunks: Sequence[Chunk], workers: int) -> list[list[int]]:
+    """Consecutive chunk numbers packed up to :data:`PACK` designs, keeping at least 2 packs per worker."""
+    if not chunks or not chunks[0].batch:
+        return [[k] for k in range(len(chunks))]
+    designs = sum(len(c.points) for c in chunks)
+    size = max(1, min(PACK, designs // (2 * workers) if workers > 1 else PACK))
+    packs: list[list[int]] = []
+    count = 0
+    for k, c in enumerate(chunks):
+        if not packs or count + len(c.points) > size:
+            packs.append([])
+            count = 0
+        packs[-1].append(k)
+        count += len(c.points)
+    return packs
 
 
 def run_sweep(
@@ -137,18 +194,22 @@ def run_sweep(
         progress(len(finished), len(chunks))
     if todo:
         work = [chunks[k] for k in todo]
+        workers = 1 if scheduler is None and (jobs == 1 or len(work) == 1) else max(jobs, 2)
+        packs = [[work[i] for i in pack] for pack in _packs(work, workers)]
+        places = [[todo[i] for i in pack] for pack in _packs(work, workers)]
         if scheduler is not None:
-            results = dask_map(evaluate_chunk, work, scheduler)
-        elif jobs == 1 or len(work) == 1:
-            results = serial_map(evaluate_chunk, work)
+            results = dask_map(evaluate_chunks, packs, scheduler)
+        elif workers == 1:
+            results = serial_map(evaluate_chunks, packs)
         else:
-            results = process_map(evaluate_chunk, work, min(jobs, len(work)), died=_DIED)
-        for j, rows in results:
-            finished[todo[j]] = rows
-            if on_chunk is not None:
-                on_chunk(todo[j], rows)
-            if progress is not None:
-                progress(len(finished), len(chunks))
+            results = process_map(evaluate_chunks, packs, min(jobs, len(packs)), died=_DIED)
+        for j, packed in results:
+            for k, rows in zip(places[j], packed, strict=True):
+                finished[k] = rows
+                if on_chunk is not None:
+                    on_chunk(k, rows)
+                if progress is not None:
+                    progress(len(finished), len(chunks))
     rows = [row for k in range(len(chunks)) for row in finished[k]]
     return _with_front(rows, plan.pareto)
 

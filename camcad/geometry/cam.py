@@ -407,6 +407,18 @@ class Cam:
             self._memo["state"] = (key, out)
         return out
 
+    def keep_state(self, phi: FloatArray, state: CamState) -> None:
+        """Keep ``state`` (and its motion) as this cam's right-side state at the sample grid ``phi`` [rad].
+
+        For a batch analysis (:mod:`camcad.explore.batch`) that evaluated the
+        grid of many variants of one design at once: :meth:`state` and
+        :meth:`motion` then give these for the grid, as if computed here.
+        """
+        key = _grid_key(phi, "right")
+        if key is not None:
+            self._memo["motion"] = (key, state.motion)
+            self._memo["state"] = (key, state)
+
     def _state(self, phi: ArrayLike, side: Side) -> CamState:
         m, element = self._element(phi, side)
         if isinstance(element, PointElement):

@@ -18,6 +18,7 @@ A line n(θ)·x = p keeps p and turns its normal angle to θ − σφ.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +30,7 @@ __all__ = [
     "Guide",
     "LineElement",
     "PointElement",
+    "keep_turn",
     "line_envelope",
     "offset_curve",
     "point_envelope",
@@ -43,9 +45,46 @@ def _quarter(v: FloatArray) -> FloatArray:
     return np.column_stack((-v[:, 1], v[:, 0]))
 
 
+_TURNS: dict[tuple[int, float], tuple[weakref.ref[FloatArray], FloatArray, FloatArray]] = {}
+_TURNS_KEPT = 8  # angle arrays whose cos and sin are kept
+_TURNS_MIN = 64  # ... of at least this many angles
+
+
+def _turn(phi: FloatArray, sigma: float) -> tuple[FloatArray, FloatArray]:
+    """The cos σφ and sin σφ of a read-only angle array, kept (one cam state turns it several times).
+
+    The cos and sin of an array of many angles cost more than the rest of a
+    turn; every curve of one cam state is turned by the same angles, so
+    they are computed once per (read-only) array and σ, the same values.
+    """
+    if phi.size < _TURNS_MIN or phi.flags.writeable:
+        return np.cos(sigma * phi), np.sin(sigma * phi)
+    key = (id(phi), sigma)
+    hit = _TURNS.get(key)
+    if hit is not None and hit[0]() is phi:
+        return hit[1], hit[2]
+    c, s = np.cos(sigma * phi), np.sin(sigma * phi)
+    if len(_TURNS) >= _TURNS_KEPT:
+        _TURNS.clear()
+    _TURNS[key] = (weakref.ref(phi), c, s)
+    return c, s
+
+
+def keep_turn(phi: FloatArray, sigma: float, cos: FloatArray, sin: FloatArray) -> None:
+    """Hand :func:`to_cam` the cos σφ and sin σφ of a read-only angle array computed elsewhere.
+
+    For a batch that stacks one sample grid many times (:mod:`camcad.explore.batch`):
+    the grid's cos and sin, tiled, are the stacked array's, value for value.
+    """
+    if phi.size >= _TURNS_MIN and not phi.flags.writeable:
+        if len(_TURNS) >= _TURNS_KEPT:
+            _TURNS.clear()
+        _TURNS[(id(phi), sigma)] = (weakref.ref(phi), cos, sin)
+
+
 def to_cam(phi: FloatArray, vectors: FloatArray, sigma: float) -> FloatArray:
     """R(−σφ)·v: machine-frame vectors (n, 2) seen from the cam at cam angles φ (n,) [rad]."""
-    c, s = np.cos(sigma * phi), np.sin(sigma * phi)
+    c, s = _turn(np.asarray(phi), sigma)
     x, y = vectors[:, 0], vectors[:, 1]
     return np.column_stack((c * x + s * y, -s * x + c * y))
 

@@ -20,7 +20,15 @@ from camcad.geometry.followers.tied import TiedRoller
 from camcad.geometry.sizing import curvature_finding, min_base_radius
 from camcad.roots import brent_root
 
-__all__ = ["GeometryAnalysis", "Undercut", "analyse_geometry", "conjugate_overlap", "undercut_error"]
+__all__ = [
+    "GEOMETRY_KINDS",
+    "GeometryAnalysis",
+    "Undercut",
+    "analyse_geometry",
+    "conjugate_overlap",
+    "geometry_rows",
+    "undercut_error",
+]
 
 _SUGGEST_ROUND_MM = 0.01
 
@@ -227,6 +235,30 @@ def _face_check(
     return needed, [found]
 
 
+GEOMETRY_KINDS: tuple[Kind, ...] = ("max", "min", "max", "min", "min", "min", "min", "max")
+"""The extreme :func:`analyse_geometry` finds of each row of :func:`geometry_rows`."""
+
+
+def geometry_rows(cam: Cam, state: CamState) -> FloatArray:
+    """(8, n) the quantities whose true extremes :func:`analyse_geometry` finds, at the state's angles.
+
+    |α| [rad], profile radius (for its min and max) [mm], convex ρ, concave ρ,
+    the undercut quantity (:meth:`Cam.loop_radius`) and the contact position
+    (for its min and max) [mm]: one row each, kinds :data:`GEOMETRY_KINDS`.
+    """
+    radius = np.hypot(state.profile.point[:, 0], state.profile.point[:, 1])
+    rho = state.profile.rho
+    undercut = cam.loop_radius(state)
+    x = state.contact_position
+    # the convex side runs on into a loop or cusp with ρ < 0: its minimum is the true signed one
+    convex = np.where(np.isfinite(undercut), rho, np.inf)
+    concave = np.where(np.isfinite(undercut), np.inf, _concave(rho))
+    out: FloatArray = np.vstack(
+        (np.abs(state.pressure_angle), radius, radius, convex, concave, undercut, x, x)
+    )
+    return out
+
+
 def analyse_geometry(
     cam: Cam,
     *,
@@ -271,25 +303,13 @@ def analyse_geometry(
     findings: list[Finding] = []
 
     roller = cam.has_pitch_curve  # a contact circle: undercut loops the profile (else a face's cusp)
-    kinds: tuple[Kind, ...] = ("max", "min", "max", "min", "min", "min", "min", "max")
 
     def rows(p: FloatArray, side: Side) -> FloatArray:
-        return rows_of(cam.state(p, side=side))
+        return geometry_rows(cam, cam.state(p, side=side))
 
-    def rows_of(st: CamState) -> FloatArray:
-        """|α|, profile radius (min, max), convex ρ, concave ρ, undercut quantity, contact x (min, max)."""
-        radius = np.hypot(st.profile.point[:, 0], st.profile.point[:, 1])
-        rho = st.profile.rho
-        undercut = cam.loop_radius(st)
-        x = st.contact_position
-        # the convex side runs on into a loop or cusp with ρ < 0: its minimum is the true signed one
-        convex = np.where(np.isfinite(undercut), rho, np.inf)
-        concave = np.where(np.isfinite(undercut), np.inf, _concave(rho))
-        return np.vstack((np.abs(st.pressure_angle), radius, radius, convex, concave, undercut, x, x))
-
-    values = rows_of(now)  # the samples: the state above, not a second evaluation
+    values = geometry_rows(cam, now)  # the samples: the state above, not a second evaluation
     alpha_max, radius_min, radius_max, convex_min, concave_min, worst, reach_min, reach_max = extremes_rows(
-        rows, phi, joints, kinds, values=values, rests=cam.rests
+        rows, phi, joints, GEOMETRY_KINDS, values=values, rests=cam.rests
     )
 
     if alpha_max.value > max_pressure_angle:
@@ -516,6 +536,12 @@ _REVERSAL_RTOL = 1e-9  # of the segment's mean |ds/dφ|: round-off, not a revers
 
 
 def _reversals(cam: Cam) -> list[Finding]:
+    """:func:`_find_reversals`, found once per motion program and lift unit (it depends on nothing else)."""
+    unit = cam.follower.kind.lift_unit
+    return list(cam.program.kept(f"reversals {unit}", lambda: tuple(_find_reversals(cam))))
+
+
+def _find_reversals(cam: Cam) -> list[Finding]:
     """A soft finding for every rise that runs backwards somewhere (or return that runs forwards).
 
     Fixed laws never do; a blend polynomial can, when its lift is too small

@@ -20,6 +20,7 @@ law, with j too the 4-5-6-7 law.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -219,9 +220,27 @@ def resolve_blends(segments: Sequence[SegmentSpec]) -> tuple[SegmentSpec, ...]:
         ``motion[i]`` when the conditions cannot be met together.
     """
     segs = tuple(segments)
-    n = len(segs)
     if not any(is_adaptive(g.law) for g in segs):
         return segs
+    try:
+        return _resolved(segs, repr(segs))  # a sweep's variants state one program many times: solved once
+    except TypeError:  # a segment that cannot be a key (unhashable data): solved here
+        return _resolve(segs)
+
+
+@functools.lru_cache(maxsize=64)
+def _resolved(segs: tuple[SegmentSpec, ...], text: str) -> tuple[SegmentSpec, ...]:
+    """:func:`_resolve`, kept for the last programs (frozen specs in, frozen specs out).
+
+    ``text`` (the specs' repr) is part of the key so that equal but distinct
+    inputs (−0.0 and 0.0) are never mixed up.
+    """
+    return _resolve(segs)
+
+
+def _resolve(segs: tuple[SegmentSpec, ...]) -> tuple[SegmentSpec, ...]:
+    """The body of :func:`resolve_blends`."""
+    n = len(segs)
     _check_boundary_fields(segs)
     families: dict[int, _Family] = {}
     size = 0

@@ -8,8 +8,9 @@ j = d³s/dφ³ [mm/rad³], exactly, from each segment's law in closed form.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -28,6 +29,8 @@ __all__ = [
     "Side",
     "TimeMotion",
 ]
+
+T = TypeVar("T")
 
 _SNAP = 1e-12  # a normalised x this close to a law's breakpoint is that breakpoint
 # A jump smaller than this (relative to the derivative's scale) is continuity.
@@ -137,7 +140,7 @@ class MotionProgram:
     segments: tuple[SegmentSpec, ...]
     starts: tuple[float, ...]  # rad, start angle of each segment
     base_s: tuple[float, ...]  # mm, displacement at each segment's start
-    _memo: dict[str, tuple[Joint, ...]] = field(  # the joints, found once (see joints)
+    _memo: dict[str, Any] = field(  # the joints and the last sample grid, found once (see joints, sample_phi)
         default_factory=dict, init=False, compare=False, hash=False, repr=False
     )
 
@@ -254,7 +257,21 @@ class MotionProgram:
         """
         if "joints" not in self._memo:
             self._memo["joints"] = self._find_joints()
-        return self._memo["joints"]
+        joints: tuple[Joint, ...] = self._memo["joints"]
+        return joints
+
+    def kept(self, key: str, compute: Callable[[], T]) -> T:
+        """``compute()`` once per program and ``key``: a finding of the motion alone that every analysis asks.
+
+        ``compute`` must depend only on this program (and on what ``key``
+        names): the variants of a sweep that share one program
+        (:mod:`camcad.explore.batch`) then check it once.
+        """
+        name = f"kept:{key}"
+        if name not in self._memo:
+            self._memo[name] = compute()
+        out: T = self._memo[name]
+        return out
 
     def _find_joints(self) -> tuple[Joint, ...]:
         n = len(self.segments)
@@ -334,7 +351,16 @@ class MotionProgram:
         return tuple(sorted({bp.phi for bp in self.breakpoints} | set(self.smooth_knots)))
 
     def sample_phi(self, step: float) -> FloatArray:
-        """Cam angles in [0, 2π): a uniform grid of ``step`` [rad] plus every breakpoint."""
+        """Cam angles in [0, 2π): a uniform grid of ``step`` [rad] plus every breakpoint (kept)."""
+        kept = self._memo.get("sample_phi")
+        if kept is not None and kept[0] == step:
+            got: FloatArray = kept[1]
+            return got
+        out = self._sample_phi(step)
+        self._memo["sample_phi"] = (step, out)
+        return out
+
+    def _sample_phi(self, step: float) -> FloatArray:
         n = max(math.ceil(TWO_PI / step - 1e-9), 8)
         grid = np.linspace(0.0, TWO_PI, n, endpoint=False)
         marks = np.mod([bp.phi for bp in self.breakpoints], TWO_PI)

@@ -18,6 +18,7 @@ noise stated too small.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -221,6 +222,20 @@ MAX_TABLE_VALUE = 1e4
 
 
 def parse_table_text(text: str, *, where: str = "file") -> tuple[FloatArray, FloatArray, FloatArray | None]:
+    """Read the rows of a point table (see :func:`_parse_table_text`); read once per text and field.
+
+    A sweep validates many variants of one design, each reading the same
+    table: the read-only arrays of the first reading are handed out again.
+    """
+    return _parse_kept(text, where)
+
+
+@functools.lru_cache(maxsize=16)
+def _parse_kept(text: str, where: str) -> tuple[FloatArray, FloatArray, FloatArray | None]:
+    return _parse_table_text(text, where=where)
+
+
+def _parse_table_text(text: str, *, where: str = "file") -> tuple[FloatArray, FloatArray, FloatArray | None]:
     """Read the rows of a point table: angle [°], lift, optional velocity; further columns ignored.
 
     Parameters
@@ -349,6 +364,29 @@ def table_scatter(angle: FloatArray, lift: FloatArray) -> float:
 
 
 def smooth_table(
+    angle: FloatArray, lift: FloatArray, *, noise: float, velocity: FloatArray | None = None, source: str = ""
+) -> TableLaw:
+    """:func:`_smooth_table`, fitted once per table, noise and source (a sweep's variants share it)."""
+
+    def bits(a: FloatArray | None) -> bytes | None:
+        return None if a is None else np.ascontiguousarray(a, dtype=float).tobytes()
+
+    return _smooth_kept(bits(angle), bits(lift), repr(float(noise)), bits(velocity), source)
+
+
+@functools.lru_cache(maxsize=16)
+def _smooth_kept(
+    angle: bytes | None, lift: bytes | None, noise: str, velocity: bytes | None, source: str
+) -> TableLaw:
+    def array(b: bytes | None) -> FloatArray | None:
+        return None if b is None else np.frombuffer(b, dtype=float)
+
+    a, y = array(angle), array(lift)
+    assert a is not None and y is not None
+    return _smooth_table(a, y, noise=float(noise), velocity=array(velocity), source=source)
+
+
+def _smooth_table(
     angle: FloatArray, lift: FloatArray, *, noise: float, velocity: FloatArray | None = None, source: str = ""
 ) -> TableLaw:
     """The periodic quintic smoothing spline of a point table, with residuals and flags.

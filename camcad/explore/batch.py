@@ -1,0 +1,649 @@
+"""Batch analysis: many variants of one design as arrays, the same bytes as analysing them one by one.
+
+A sweep's chunk (or an optimiser's finite-difference stencil) holds designs
+that differ only in a few keys: the base radius, the roller radius, the
+offset, the spring, the speed. Analysed one by one (:func:`camcad.pipeline.analyse`)
+each costs tens of milliseconds, most of it spent by the true-extreme
+searches (:mod:`camcad.extremes`) calling the exact cam a few dozen times on
+a handful of angles each. Here the variants that share one motion structure
+(one motion program, rotation, sample step, follower kind and cam family)
+are analysed together:
+
+- the motion on the sample grid is evaluated once for all of them;
+- the cam's state (envelope, profile, pressure angle, contact) on the grid
+  is evaluated once on the (variants × angles) stack, the follower's
+  parameters as one value per stacked angle (:class:`_FollowerStack`);
+- the geometry's and the dynamics' true extremes of all variants are found
+  by one search (:func:`camcad.extremes.extremes_stacked`) whose rows are
+  the variants' rows, each refinement step one call of the stacked cam;
+- then each variant is analysed by the ordinary stages, its grid state
+  handed to its cam (:meth:`camcad.geometry.cam.Cam.keep_state`) and its
+  searches answered from the batch (:func:`camcad.extremes.served`).
+
+Why the bytes are the same: every step of the search is elementwise per
+row and per bracket, the quantities are the same functions evaluated
+elementwise on the same angles (a parameter as one value per angle instead
+of one scalar gives the same IEEE products and sums), and an analysis takes
+a batch answer only when the samples it computed itself are bit-for-bit the
+ones the batch searched from; any other search runs as usual. Variants of
+another structure, other families (groove, conjugate pair, linear cam), a
+``[vibration]`` table, or a follower whose non-numeric parameters differ
+(an arm's pivot) are analysed one by one (:func:`analyse_one`).
+"""
+
+from __future__ import annotations
+
+import copy
+import types
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields, is_dataclass, replace
+from typing import TYPE_CHECKING, Any, cast
+
+import numpy as np
+
+from camcad._typing import FloatArray, readonly
+from camcad.errors import CamcadError
+from camcad.explore.measures import Limit, analysis_row, failed_row
+from camcad.explore.space import Variable, design_with
+
+if TYPE_CHECKING:
+    from camcad.analysis import Analysis
+    from camcad.design import Design
+    from camcad.extremes import Extreme, Kind, Side
+    from camcad.geometry.cam import Cam, CamState
+    from camcad.geometry.curves import CurveSample
+    from camcad.motion.program import Motion
+
+__all__ = ["BatchStats", "analyse_many", "analyse_one", "analyse_rows", "chunk_rows", "structure_key"]
+
+
+@dataclass(slots=True)
+class BatchStats:
+    """How a batch went: variants analysed in batches, one by one, and searches answered by a batch."""
+
+    batched: int = 0
+    single: int = 0
+    served: int = 0
+    searches: int = 0
+
+
+def analyse_one(design: Design) -> Analysis:
+    """The per-design analysis a sweep row is made from (as ``camcad check``: no fit, toolpath, strict)."""
+    from camcad.pipeline import analyse
+
+    return analyse(design, fit=False, toolpath=False, strict=False)
+
+
+def structure_key(design: Design) -> str | None:
+    """What variants must share to be analysed together; None for a design analysed one by one.
+
+    The motion program's segments, the rotation, the sample step, the
+    follower kind and the cam style; a design with ``[vibration]`` (whose
+    compensated lift would change the program) is analysed alone. A family
+    of more than one part (a conjugate pair) or an open profile (a linear
+    cam) is found out when the group is built, and analysed one by one.
+    """
+    if design.vibration is not None:
+        return None
+    cam = design.cam
+    return repr((design.motion, cam.rotation, cam.sample_step, cam.style, design.follower.kind))
+
+
+class _Unsupported(Exception):
+    """A group the stacked cam cannot evaluate: its variants are analysed one by one."""
+
+
+def _equal(values: Sequence[Any]) -> bool:
+    first = values[0]
+    try:
+        return all(bool(v == first) for v in values[1:])
+    except (TypeError, ValueError):  # arrays: not one value
+        return False
+
+
+class _FollowerStack:
+    """Many followers of one class as one: each numeric parameter an array, one value per stacked angle.
+
+    The follower's own methods (its element, its contact position) run on
+    it unchanged; a property is read on every variant's follower (so a
+    derived value such as k = √((r_b + r_f)² − e²) is each variant's own
+    scalar, computed as in a single analysis) and stacked. A non-numeric
+    attribute that differs between the variants (an arm's pivot) is
+    :class:`_Unsupported`.
+    """
+
+    def __init__(self, followers: Sequence[Any]) -> None:
+        cls = type(followers[0])
+        if any(type(f) is not cls for f in followers):
+            raise _Unsupported("mixed follower kinds")
+        methods: dict[str, Any] = {}
+        self.constant: dict[str, Any] = {}
+        self.varying: dict[str, FloatArray] = {}
+        for klass in reversed(cls.__mro__[:-1]):
+            for name, obj in vars(klass).items():
+                if name.startswith("__"):
+                    continue
+                if isinstance(obj, (property, types.MemberDescriptorType)):
+                    try:
+                        values = [getattr(f, name) for f in followers]
+                    except Exception:  # a property this kind does not have: left out
+                        continue
+                    if _equal(values):
+                        self.constant[name] = values[0]
+                    elif all(isinstance(v, (float, int)) and not isinstance(v, bool) for v in values):
+                        self.varying[name] = np.array(values, dtype=float)
+                    else:
+                        raise _Unsupported(f"the follower's {name} differs between the variants")
+                elif isinstance(obj, (types.FunctionType, staticmethod, classmethod)):
+                    methods[name] = obj
+        self.view_class = type(f"_{cls.__name__}Stack", (), methods)
+
+    def at(self, which: np.ndarray) -> Any:
+        """The stacked follower for angles of the variants ``which`` (one index per angle)."""
+        view: Any = object.__new__(self.view_class)
+        view.__dict__.update(self.constant)
+        for name, values in self.varying.items():
+            setattr(view, name, values[which])
+        return view
+
+
+@dataclass(frozen=True, slots=True)
+class _Stacked:
+    """Many frozen dataclasses of one type as one: a differing number becomes one value per stacked angle.
+
+    ``varying`` holds each differing numeric field's values over the variants
+    (V,), ``nested`` the differing dataclass fields; equal fields are the
+    first object's. A differing field of another type is :class:`_Unsupported`.
+    """
+
+    first: Any
+    varying: Mapping[str, FloatArray]
+    nested: Mapping[str, _Stacked]
+
+    @staticmethod
+    def of(objects: Sequence[Any]) -> _Stacked:
+        first = objects[0]
+        if not is_dataclass(first) or any(type(o) is not type(first) for o in objects):
+            raise _Unsupported("not one dataclass")
+        varying: dict[str, FloatArray] = {}
+        nested: dict[str, _Stacked] = {}
+        for f in fields(first):
+            values = [getattr(o, f.name) for o in objects]
+            if _equal(values):
+                continue
+            if all(isinstance(v, (float, int)) and not isinstance(v, bool) for v in values):
+                varying[f.name] = np.array(values, dtype=float)
+            elif is_dataclass(values[0]):
+                nested[f.name] = _Stacked.of(values)
+            else:
+                raise _Unsupported(f"{f.name} differs between the variants")
+        return _Stacked(first=first, varying=varying, nested=nested)
+
+    def at(self, which: np.ndarray) -> Any:
+        """The object with each differing number the value of variant ``which[i]`` at stacked angle i."""
+        out = copy.copy(self.first)
+        for name, values in self.varying.items():
+            object.__setattr__(out, name, values[which])  # frozen: set as its own constructor would
+        for name, inner in self.nested.items():
+            object.__setattr__(out, name, inner.at(which))
+        return out
+
+
+def _offset(base: CurveSample, drho: FloatArray, delta: float | FloatArray) -> CurveSample:
+    """:func:`camcad.geometry.envelope.offset_curve` with one offset per angle (the same operations)."""
+    from camcad.geometry.curves import CurveSample
+    from camcad.geometry.envelope import offset_curve
+
+    if np.ndim(delta) == 0:
+        return offset_curve(base, drho, float(delta))
+    d = np.asarray(delta, dtype=float)
+    rho = base.rho
+    with np.errstate(divide="ignore", invalid="ignore"):
+        stretch = np.where(np.isinf(rho), 1.0, 1.0 + d / rho)
+        bend = np.where(np.isinf(rho), 0.0, d * drho / rho**2)
+    return CurveSample(
+        phi=base.phi,
+        point=base.point + d[:, None] * base.normal,
+        d1=base.d1 * stretch[:, None],
+        d2=base.d2 * stretch[:, None] - base.d1 * bend[:, None],
+        tangent=base.tangent,
+        normal=base.normal,
+        rho=rho + d,
+    )
+
+
+class _Loop:
+    """The one thing :func:`~camcad.geometry.limits.geometry_rows` asks the cam: its undercut quantity."""
+
+    def __init__(self, has_pitch_curve: bool) -> None:
+        self.has_pitch_curve = has_pitch_curve
+
+    def loop_radius(self, state: CamState) -> FloatArray:
+        from camcad.geometry.cam import Cam
+
+        return Cam.loop_radius(cast(Cam, self), state)
+
+
+def _take(motion: Motion, index: np.ndarray | slice) -> Motion:
+    return replace(motion, **{f.name: getattr(motion, f.name)[index] for f in fields(motion)})
+
+
+def _tile(motion: Motion, times: int) -> Motion:
+    out = replace(motion, **{f.name: np.tile(getattr(motion, f.name), times) for f in fields(motion)})
+    readonly(*(getattr(out, f.name) for f in fields(out)))
+    return out
+
+
+@dataclass(slots=True)
+class _Group:
+    """Variants of one structure: their designs and cams, the stacked follower, the shared grid."""
+
+    designs: list[Design]
+    cams: list[Cam]
+    stack: _FollowerStack
+    sigma: float
+    pitch: bool
+    phi: FloatArray
+    grid_motion: Motion
+    drive_signs: list[float]
+
+    @property
+    def size(self) -> int:
+        return len(self.cams)
+
+    def motion(self, phi: FloatArray, side: Side) -> Motion:
+        return self.cams[0].program.evaluate(phi, side=side)
+
+    def state(self, motion: Motion, which: np.ndarray) -> CamState:
+        """The cam's state of variant ``which[i]`` at ``motion.phi[i]``, as :meth:`Cam.state` computes it."""
+        from camcad.geometry.cam import CamState
+        from camcad.geometry.envelope import (
+            PointElement,
+            line_envelope,
+            point_envelope,
+            pressure_angle,
+            to_cam,
+        )
+
+        fol = self.stack.at(which)
+        element = fol.element(motion)
+        if isinstance(element, PointElement):
+            base, drho = point_envelope(motion.phi, element, self.sigma)
+            profile = _offset(base, drho, -fol.roller_radius)
+            driven = base.point
+        else:
+            base, drho = line_envelope(motion.phi, element, self.sigma)
+            profile = base
+            driven = profile.point
+        guide = fol.guide
+        turned = np.asarray(motion.phi, dtype=float)
+        driven_machine = to_cam(turned, np.asarray(driven, dtype=float), -self.sigma)
+        alpha = pressure_angle(turned, profile.normal, driven_machine, guide, self.sigma)
+        contact = to_cam(turned, np.asarray(profile.point, dtype=float), -self.sigma)
+        lever = None
+        if guide.pivot is not None:
+            arm = driven_machine - np.asarray(guide.pivot)
+            lever = np.hypot(arm[:, 0], arm[:, 1])
+        position = fol.contact_position(contact, motion)
+        return CamState(
+            lever=lever,
+            motion=motion,
+            base=base,
+            profile=profile,
+            pressure_angle=alpha,
+            contact_position=position,
+        )
+
+
+def _group(designs: list[Design]) -> _Group:
+    from camcad.geometry.cam import Cam, follower_from_spec
+    from camcad.geometry.families import family_of
+
+    # the followers first: a group whose followers cannot be stacked (an arm's pivot that moves) is
+    # refused before anything else is built
+    _FollowerStack([follower_from_spec(d.follower, d.cam.base_radius) for d in designs])
+    first = Cam.from_design(designs[0])
+    cams = [first] + [replace(Cam.from_design(d), program=first.program) for d in designs[1:]]
+    signs = []
+    for d, c in zip(designs, cams, strict=True):
+        parts = family_of(d.cam.style).parts(c, d.family_options())
+        if len(parts) != 1 or parts[0].cam is not c:
+            raise _Unsupported("a family of more than one part")
+        signs.append(parts[0].drive_sign)
+    stack = _FollowerStack([c.kinematics for c in cams])
+    pitch = {c.has_pitch_curve for c in cams}
+    if len(pitch) != 1 or any(not c.closed for c in cams):
+        raise _Unsupported("mixed contact kinds")
+    phi = cams[0].sample_phi()
+    return _Group(
+        designs=designs,
+        cams=cams,
+        stack=stack,
+        sigma=cams[0].sigma,
+        pitch=pitch.pop(),
+        phi=phi,
+        grid_motion=cams[0].motion(phi),
+        drive_signs=signs,
+    )
+
+
+def _state_slice(state: CamState, lo: int, hi: int) -> CamState:
+    """The rows lo … hi − 1 of a stacked state (one variant's grid)."""
+
+    def curve(c: CurveSample) -> CurveSample:
+        return replace(c, **{f.name: getattr(c, f.name)[lo:hi] for f in fields(c)})
+
+    return replace(
+        state,
+        motion=_take(state.motion, slice(lo, hi)),
+        base=curve(state.base),
+        profile=curve(state.profile),
+        pressure_angle=state.pressure_angle[lo:hi],
+        contact_position=state.contact_position[lo:hi],
+        lever=None if state.lever is None else state.lever[lo:hi],
+    )
+
+
+Answer = tuple[
+    FloatArray,
+    FloatArray,
+    tuple["Kind", ...],
+    FloatArray,
+    tuple[tuple[float, float], ...],
+    tuple[bool, ...],
+    tuple["Extreme", ...],
+]
+"""A search done ahead: grid, joints, kinds, sampled values, rests, settled rows, the extremes found."""
+
+
+def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
+    """Every variant's grid state and the answers of its geometry and dynamics searches."""
+    from camcad.dynamics.model import dynamics_rows, extreme_rows
+    from camcad.extremes import extremes_stacked
+    from camcad.geometry.cam import Cam
+    from camcad.geometry.envelope import keep_turn
+    from camcad.geometry.limits import GEOMETRY_KINDS, geometry_rows
+
+    nv, n = group.size, group.phi.size
+    loop = cast(Cam, _Loop(group.pitch))
+    joints = np.array([bp.phi for bp in group.cams[0].program.breakpoints], dtype=float)
+    rests = group.cams[0].rests
+    every = np.repeat(np.arange(nv), n)
+    tiled = _tile(group.grid_motion, nv)
+    for sigma in (group.sigma, -group.sigma):  # the grid's turn, once for all the variants
+        keep_turn(
+            tiled.phi, sigma, np.tile(np.cos(sigma * group.phi), nv), np.tile(np.sin(sigma * group.phi), nv)
+        )
+    stacked = group.state(tiled, every)
+    states = [_state_slice(stacked, v * n, (v + 1) * n) for v in range(nv)]
+
+    def stacked_at(p: FloatArray, which: np.ndarray, side: Side) -> CamState:
+        return group.state(group.motion(p, side), which)
+
+    # dynamics: variants with equal setups share one model; different ones, one model of stacked parameters
+    setups = [
+        replace(d.dynamics_setup(), drive_sign=sign, roller_radius=c.roller_radius)
+        for d, c, sign in zip(group.designs, group.cams, group.drive_signs, strict=True)
+    ]
+    models: list[tuple[Any, list[int]]] = []
+    for v, s in enumerate(setups):
+        for held in models:
+            if held[0][0] == s:
+                held[1].append(v)
+                break
+        else:
+            models.append(((s, extreme_rows(s)), [v]))
+    kinds = models[0][0][1][0]
+    if any(m[0][1][0] != kinds for m in models):
+        raise _Unsupported("mixed dynamics rows")
+    kd = len(kinds)
+    owner = np.empty(nv, dtype=int)
+    for g, (_, members) in enumerate(models):
+        owner[members] = g
+    stacked_setup = _Stacked.of(setups) if len(models) > 1 else None
+
+    def drows(st: CamState, which: np.ndarray) -> FloatArray:
+        """(kd, m) each angle's rows of its own variant's model."""
+        nonlocal stacked_setup
+        if stacked_setup is not None:
+            try:  # one model, each parameter one value per angle
+                rows = dynamics_rows(stacked_setup.at(which))
+                return np.asarray(rows(st.motion, st.pressure_angle, st.profile.rho, st.lever), dtype=float)
+            except (TypeError, ValueError, AttributeError):  # the model takes a parameter as a scalar
+                stacked_setup = None
+        out = np.empty((kd, which.size))
+        for g, ((_, (_, _, rows)), _) in enumerate(models):
+            mine = np.flatnonzero(owner[which] == g)
+            if mine.size == which.size:
+                return np.asarray(rows(st.motion, st.pressure_angle, st.profile.rho, st.lever), dtype=float)
+            if mine.size:
+                lever = None if st.lever is None else st.lever[mine]
+                out[:, mine] = rows(
+                    _take(st.motion, mine), st.pressure_angle[mine], st.profile.rho[mine], lever
+                )
+        return out
+
+    # one search for both stages: variant v's rows are v·k … v·k + k − 1, its geometry's 8 then its
+    # dynamics' (each row's search is its own, so stacking them changes nothing but the number of calls)
+    kg = len(GEOMETRY_KINDS)
+    k = kg + kd
+
+    def both(st: CamState, which: np.ndarray) -> FloatArray:
+        """(k, m) every row at each angle, of the angle's own variant."""
+        return np.vstack((geometry_rows(loop, st), drows(st, which)))
+
+    def by_variant(values: FloatArray, m: int) -> FloatArray:
+        """(k, V·m) rows of the variants' angles in turn → (V·k, m), variant after variant."""
+        out: FloatArray = values.reshape(k, nv, m).transpose(1, 0, 2).reshape(nv * k, m)
+        return out
+
+    values = by_variant(both(stacked, every), n)
+
+    def quantity(p: FloatArray, side: Side) -> FloatArray:
+        m = p.size
+        which = np.repeat(np.arange(nv), m)
+        return by_variant(both(stacked_at(np.tile(p, nv), which, side), which), m)
+
+    def pick(p: FloatArray, rows: np.ndarray, side: Side) -> FloatArray:
+        which = rows // k
+        out: FloatArray = both(stacked_at(p, which, side), which)[rows % k, np.arange(p.size)]
+        return out
+
+    settled: list[bool] = []
+    for v in range(nv):
+        settled += [False] * kg + list(models[owner[v]][0][1][1])
+    found = extremes_stacked(
+        quantity,
+        pick,
+        group.phi,
+        joints,
+        (GEOMETRY_KINDS + kinds) * nv,
+        values=values,
+        rests=rests,
+        settled=settled,
+    )
+    answers: list[list[Answer]] = []
+    for v in range(nv):
+        lo, mid, hi = v * k, v * k + kg, (v + 1) * k
+        answers.append(
+            [
+                (group.phi, joints, GEOMETRY_KINDS, values[lo:mid], rests, (), found[lo:mid]),
+                (group.phi, joints, kinds, values[mid:hi], rests, models[owner[v]][0][1][1], found[mid:hi]),
+            ]
+        )
+    return states, answers
+
+
+def _assemble(design: Design, cam: Cam) -> Analysis:
+    """:func:`analyse_one` for a plate cam whose grid state and searches are at hand (the same stages)."""
+    from camcad.analysis import Analysis, PartResult
+    from camcad.dynamics import analyse_dynamics
+    from camcad.geometry import analyse_geometry
+    from camcad.geometry.families import family_of
+
+    family = family_of(design.cam.style)
+    parts = family.parts(cam, design.family_options())
+    geometries = [
+        analyse_geometry(
+            part.cam,
+            max_pressure_angle=design.cam.max_pressure_angle,
+            face_width=design.follower.face_width,
+            face_margin=design.follower.face_margin,
+            min_curvature_radius=design.min_curvature_radius,
+        )
+        for part in parts
+    ]
+    motion = cam.motion(geometries[0].phi)
+    setup = design.dynamics_setup()
+    dynamics = [
+        analyse_dynamics(
+            part.cam.motion(g.phi),
+            pressure_angle=g.pressure_angle,
+            profile_rho=g.profile.rho,
+            setup=replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius),
+            cam=part.cam,
+        )
+        for part, g in zip(parts, geometries, strict=True)
+    ]
+    results = [
+        PartResult(part=part, geometry=g, dynamics=d)
+        for part, g, d in zip(parts, geometries, dynamics, strict=True)
+    ]
+    duty = None
+    if design.life is not None or design.lubrication is not None or design.drive is not None:
+        from camcad.dynamics.duty import analyse_duty
+
+        duty = analyse_duty(
+            cam,
+            dynamics[0],
+            setup=setup,
+            profile=geometries[0].profile,
+            life=design.life,
+            lubrication=design.lubrication,
+            drive=design.drive,
+        )
+    return Analysis(
+        design=design, family=family, parts=tuple(results), motion=motion, toolpath=None, duty=duty
+    )
+
+
+Row = dict[str, Any]
+
+
+def analyse_many(
+    designs: Sequence[Design],
+    *,
+    batch: bool = True,
+    stats: BatchStats | None = None,
+) -> list[Analysis | CamcadError]:
+    """Each design's analysis (as :func:`analyse_one`), or the error it raised, in order.
+
+    With ``batch`` the designs of one structure (:func:`structure_key`) are
+    analysed together (see the module notes), the others one by one; every
+    analysis is the same either way, to the bit.
+    """
+    stats = stats if stats is not None else BatchStats()
+    out: list[Analysis | CamcadError | None] = [None] * len(designs)
+    groups: dict[str, list[int]] = {}
+    for i, d in enumerate(designs):
+        key = structure_key(d) if batch else None
+        if key is None:
+            out[i] = _single(d)
+            stats.single += 1
+        else:
+            groups.setdefault(key, []).append(i)
+    for members in groups.values():
+        done = _batched([designs[i] for i in members], stats) if len(members) > 1 else None
+        if done is None:
+            for i in members:
+                out[i] = _single(designs[i])
+            stats.single += len(members)
+            continue
+        for i, got in zip(members, done, strict=True):
+            out[i] = got
+        stats.batched += len(members)
+    return [a for a in out if a is not None]
+
+
+def analyse_rows(
+    designs: Sequence[Design | CamcadError],
+    limits: Sequence[Limit] = (),
+    *,
+    batch: bool = True,
+    stats: BatchStats | None = None,
+) -> list[Row]:
+    """The sweep row (:func:`~camcad.explore.measures.analysis_row`) of each design, in order.
+
+    A design given as the error its variant raised becomes its failed row;
+    the rows are the same bytes with ``batch`` on or off.
+    """
+    from camcad.analysis import Analysis
+
+    valid = [d for d in designs if not isinstance(d, CamcadError)]
+    analysed = iter(analyse_many(valid, batch=batch, stats=stats))
+    rows: list[Row] = []
+    for d in designs:
+        got = d if isinstance(d, CamcadError) else next(analysed)
+        rows.append(analysis_row(got, limits) if isinstance(got, Analysis) else failed_row(got, limits))
+    return rows
+
+
+def _single(design: Design) -> Analysis | CamcadError:
+    try:
+        return analyse_one(design)
+    except CamcadError as err:
+        return err
+
+
+def _batched(designs: list[Design], stats: BatchStats) -> list[Analysis | CamcadError] | None:
+    """One structure's designs analysed together; None where the stacked cam cannot."""
+    from camcad.analysis import motion_summary
+    from camcad.extremes import served
+
+    try:
+        with np.errstate(all="ignore"):
+            group = _group(designs)
+            states, answers = _searches(group)
+    except (_Unsupported, CamcadError, ValueError, TypeError, AttributeError, IndexError):
+        return None
+    out: list[Analysis | CamcadError] = []
+    shared: Any = None
+    for design, cam, state, mine in zip(designs, group.cams, states, answers, strict=True):
+        cam.keep_state(group.phi, replace(state, motion=group.grid_motion))
+        with served(mine) as held:
+            try:
+                analysis = _assemble(design, cam)
+            except CamcadError as err:
+                out.append(err)
+                continue
+        stats.served += held.used
+        stats.searches += len(mine)
+        if shared is None:  # one program and lift unit: one motion summary (summary() hands out copies)
+            shared = motion_summary(analysis.cam, analysis.motion)
+        analysis._memo["motion"] = shared
+        out.append(analysis)
+    return out
+
+
+def chunk_rows(
+    data: Mapping[str, Any],
+    variables: Sequence[Variable],
+    points: Sequence[Sequence[Any]],
+    *,
+    limits: Sequence[Limit] = (),
+    source: str = "",
+    batch: bool = True,
+    stats: BatchStats | None = None,
+) -> list[Row]:
+    """Each point's sweep row: its inputs, then its analysis row (a refused variant: its reason)."""
+    designs: list[Design | CamcadError] = []
+    for values in points:
+        try:
+            designs.append(design_with(data, variables, values, source=source))
+        except CamcadError as err:
+            designs.append(err)
+    out = analyse_rows(designs, limits, batch=batch, stats=stats)
+    return [
+        {v.name: value for v, value in zip(variables, values, strict=True)} | row
+        for values, row in zip(points, out, strict=True)
+    ]
