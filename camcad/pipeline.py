@@ -212,28 +212,7 @@ def analyse(
     ]
     drive = None
     if design.life is not None or design.lubrication is not None or design.drive is not None:
-        from camcad.dynamics.duty import analyse_duty, analyse_train_drive
-
-        def duty_of(result: PartResult) -> PartResult:  # every part's life and film, by the same code
-            if design.life is None and design.lubrication is None:
-                return result
-            duty = analyse_duty(
-                result.part.cam,
-                result.dynamics,
-                setup=setup_of(result.part),
-                profile=result.geometry.profile,
-                life=design.life,
-                lubrication=design.lubrication,
-            )
-            return replace(result, duty=duty)
-
-        def duties() -> tuple[list[PartResult], Any]:
-            train = None  # the motor turns the camshaft: a figure of the train, not of a part
-            if design.drive is not None:
-                train = analyse_train_drive(cam, dynamics[0], setup=setup, spec=design.drive)
-            return [duty_of(r) for r in results], train
-
-        results, drive = _timed(timings, progress, "duty", duties)
+        results, drive = _timed(timings, progress, "duty", lambda: part_duties(design, cam, results))
     later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
     if fit and not hard:
         fit_curve = partial(
@@ -704,6 +683,37 @@ def _write_barrel_files(
             assert r.wall_fit is not None  # build always fits, and fails on walls it cannot certify
             written.append(write_barrel_step(folder, r.part, fit=r.wall_fit, name=design.cam.name))
     return written
+
+
+def part_duties(design: Design, cam: Cam, results: Sequence[PartResult]) -> tuple[list[PartResult], Any]:
+    """Every part's life and film by the same code, and the train's drive ([life], [lubrication], [drive]).
+
+    Each part is loaded through its own roller and drive sign (Johnson 1985,
+    §4.3); the motor turns the camshaft, so the drive is a figure of the
+    follower train, computed once from the first part's dynamics.
+    """
+    from camcad.dynamics.duty import analyse_duty, analyse_train_drive
+
+    setup = design.dynamics_setup()
+
+    def duty_of(result: PartResult) -> PartResult:
+        if design.life is None and design.lubrication is None:
+            return result
+        part = result.part
+        duty = analyse_duty(
+            part.cam,
+            result.dynamics,
+            setup=replace(setup, drive_sign=part.drive_sign, roller_radius=part.cam.roller_radius),
+            profile=result.geometry.profile,
+            life=design.life,
+            lubrication=design.lubrication,
+        )
+        return replace(result, duty=duty)
+
+    train = None
+    if design.drive is not None:
+        train = analyse_train_drive(cam, results[0].dynamics, setup=setup, spec=design.drive)
+    return [duty_of(r) for r in results], train
 
 
 def _fitted(result: PartResult) -> ProfileFit:

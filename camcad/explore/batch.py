@@ -310,7 +310,7 @@ def _group(designs: list[Design]) -> _Group:
         if len(parts) != 1 or parts[0].cam is not c:
             raise _Unsupported("a family of more than one part")
         signs.append(parts[0].drive_sign)
-    stack = _FollowerStack([c.kinematics for c in cams])
+    stack = _FollowerStack([c.follower for c in cams])
     pitch = {c.has_pitch_curve for c in cams}
     if len(pitch) != 1 or any(not c.closed for c in cams):
         raise _Unsupported("mixed contact kinds")
@@ -509,21 +509,13 @@ def _assemble(design: Design, cam: Cam) -> Analysis:
         PartResult(part=part, geometry=g, dynamics=d)
         for part, g, d in zip(parts, geometries, dynamics, strict=True)
     ]
-    duty = None
+    drive = None
     if design.life is not None or design.lubrication is not None or design.drive is not None:
-        from camcad.dynamics.duty import analyse_duty
+        from camcad.pipeline import part_duties  # the same per-part life, film and train drive
 
-        duty = analyse_duty(
-            cam,
-            dynamics[0],
-            setup=setup,
-            profile=geometries[0].profile,
-            life=design.life,
-            lubrication=design.lubrication,
-            drive=design.drive,
-        )
+        results, drive = part_duties(design, cam, results)
     return Analysis(
-        design=design, family=family, parts=tuple(results), motion=motion, toolpath=None, duty=duty
+        design=design, family=family, parts=tuple(results), motion=motion, toolpath=None, drive=drive
     )
 
 

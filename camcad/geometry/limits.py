@@ -537,7 +537,7 @@ _REVERSAL_RTOL = 1e-9  # of the segment's mean |ds/dφ|: round-off, not a revers
 
 def _reversals(cam: Cam) -> list[Finding]:
     """:func:`_find_reversals`, found once per motion program and lift unit (it depends on nothing else)."""
-    unit = cam.follower.kind.lift_unit
+    unit = cam.follower_spec.kind.lift_unit
     return list(cam.program.kept(f"reversals {unit}", lambda: tuple(_find_reversals(cam))))
 
 
