@@ -287,7 +287,8 @@ _RIB_UNPLANNED = Finding(
     field="cam.style",
     message=(
         'cam.style: "barrel-rib" gets no cam.ngc: the 4-axis program machines a groove, and a rib needs '
-        "the barrel's whole surface round it cut away, which is not planned; cam.step, cam.stl and profile.dxf are written"
+        "the barrel's whole surface round it cut away, which is not planned; "
+        "cam.step, cam.stl and profile.dxf are written"
     ),
 )
 
