@@ -156,14 +156,17 @@ def test_dxf_holds_both_faces_within_the_fit_tolerance_of_the_exact_faces(folder
 def test_rib_thickness_rows_are_the_brute_force_least_width(folder, capsys):
     o = RIB.options
     rib = _summary(folder)["barrel"]["rib"]["thickness_min"]
-    phi = np.linspace(-0.5, 2.0 * math.pi + 0.5, 400_001)  # past the ends: the faces repeat
-    inner = (phi >= 0.0) & (phi < 2.0 * math.pi)
+    # the lower face past the period's ends (the faces repeat), as a polygon of 0.0002 rad chords (sag < 1e-7 mm)
+    lower_phi = np.linspace(-0.5, 2.0 * math.pi + 0.5, 34_001)
     for where, station in (("bottom", o.bottom_radius), ("top", o.barrel_radius)):
-        upper, lower = _closed_form_faces(station, phi)
-        least = distance_to_polygon(upper[inner], lower)  # each point of the upper face to the lower face
-        k = int(np.argmin(least))
-        assert rib[where]["value_mm"] == pytest.approx(least[k], abs=1e-5), where
-        assert rib[where]["angle_deg"] == pytest.approx(math.degrees(phi[inner][k]), abs=0.1), where
+        lower = _closed_form_faces(station, lower_phi)[1]
+        coarse = np.linspace(0.0, 2.0 * math.pi, 7_200, endpoint=False)  # each upper point's distance
+        k = int(np.argmin(distance_to_polygon(_closed_form_faces(station, coarse)[0], lower)))
+        fine = coarse[k] + np.linspace(-0.002, 0.002, 4_001)  # then 1e-6 rad steps round the least
+        least = distance_to_polygon(_closed_form_faces(station, fine)[0], lower)
+        j = int(np.argmin(least))
+        assert rib[where]["value_mm"] == pytest.approx(least[j], abs=1e-5), where
+        assert rib[where]["angle_deg"] == pytest.approx(math.degrees(fine[j]), abs=0.1), where
         assert 0.0 < rib[where]["value_mm"] < o.rib_width  # the flanks narrow it, the dwells keep w
     assert main(["check", str(SAMPLE)]) == 0
     out = capsys.readouterr().out
