@@ -128,8 +128,9 @@ def _closed_form_faces(station: float, phi: np.ndarray) -> tuple[np.ndarray, np.
     h, r_w, z0 = o.rib_offset, o.roller_radius + 0.5 * o.clearance, RIB.follower.axial_position
     normal = np.column_stack((-m.v, np.full_like(phi, station))) / np.hypot(station, m.v)[:, None]
     line = np.column_stack((station * phi, z0 + m.s))
-    upper = line + [0.0, h] - r_w * normal  # the +h roller's lower wall
-    lower = line - [0.0, h] + r_w * normal  # the −h roller's upper wall
+    shift = np.array([0.0, h])
+    upper = line + shift - r_w * normal  # the +h roller's lower wall
+    lower = line - shift + r_w * normal  # the −h roller's upper wall
     return upper, lower
 
 
@@ -156,7 +157,7 @@ def test_dxf_holds_both_faces_within_the_fit_tolerance_of_the_exact_faces(folder
 def test_rib_thickness_rows_are_the_brute_force_least_width(folder, capsys):
     o = RIB.options
     rib = _summary(folder)["barrel"]["rib"]["thickness_min"]
-    # the lower face past the period's ends (the faces repeat), as a polygon of 0.0002 rad chords (sag < 1e-7 mm)
+    # the lower face past the period's ends (the faces repeat), a polygon of 0.0002 rad chords (sag < 1e-7 mm)
     lower_phi = np.linspace(-0.5, 2.0 * math.pi + 0.5, 34_001)
     for where, station in (("bottom", o.bottom_radius), ("top", o.barrel_radius)):
         lower = _closed_form_faces(station, lower_phi)[1]
@@ -212,15 +213,19 @@ def _rib_text(**cam: object) -> str:
         ("a word for rib_width", lambda: _rib_text(rib_width="wide")),
         (
             "rib_width on a groove barrel",
-            lambda: (ROOT / "samples" / "barrel_indexer.toml")
-            .read_text(encoding="utf-8")
-            .replace("[cam]\n", "[cam]\nrib_width = 14.0\n", 1),
+            lambda: (
+                (ROOT / "samples" / "barrel_indexer.toml")
+                .read_text(encoding="utf-8")
+                .replace("[cam]\n", "[cam]\nrib_width = 14.0\n", 1)
+            ),
         ),
         (
             "rib_width on a plate",
-            lambda: (ROOT / "samples" / "offset_roller.toml")
-            .read_text(encoding="utf-8")
-            .replace("[cam]\n", "[cam]\nrib_width = 14.0\n", 1),
+            lambda: (
+                (ROOT / "samples" / "offset_roller.toml")
+                .read_text(encoding="utf-8")
+                .replace("[cam]\n", "[cam]\nrib_width = 14.0\n", 1)
+            ),
         ),
     ],
 )
@@ -236,7 +241,7 @@ def test_a_rib_without_a_barrel_radius_exits_2_naming_it(tmp_path, capsys):
 
 
 def test_a_rib_too_thin_for_its_flanks_is_a_hard_limit_naming_rib_width(tmp_path, capsys):
-    """The flanks narrow a 14 mm rib to 10.34 mm at its root (the brute force above): at 2 mm its faces cross."""
+    """The flanks narrow a 14 mm rib to 10.34 mm at its root (the brute force above): at 2 mm they cross."""
     assert main(["check", str(_bad(tmp_path, _rib_text(rib_width=2.0)))]) == 3
     assert "cam.rib_width" in capsys.readouterr().out
 
