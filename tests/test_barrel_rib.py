@@ -276,3 +276,16 @@ def test_same_input_same_bytes(folder, tmp_path):
             assert a == b
             continue
         assert (first / n).read_bytes() == (again / n).read_bytes(), n
+
+
+def test_the_designers_form_asks_a_rib_for_its_width_and_a_groove_barrel_not():
+    from camcad.design.editor_schema import design_json_schema
+    from camcad.serve.form import _conditional_required
+
+    schema = design_json_schema()
+    rib = _conditional_required(schema, {"cam": {"style": "barrel-rib"}})
+    assert {"barrel_radius", "length", "rib_width"} <= rib["cam"] and "base_radius" not in rib["cam"]
+    groove = _conditional_required(schema, {"cam": {"style": "barrel"}})
+    assert {"barrel_radius", "length"} <= groove["cam"] and "rib_width" not in groove["cam"]
+    plate = _conditional_required(schema, {"cam": {"style": "plate"}})
+    assert "base_radius" in plate["cam"] and "rib_width" not in plate["cam"]
