@@ -252,7 +252,7 @@ def analyse(
         render = render_rotary_program if rotary else render_program
         spent = 0.0
         for index, result in enumerate(results):
-            if not result.part.made:
+            if not (result.part.made and result.part.program):  # a part without a program: its note says why
                 continue
             timings.pop("toolpath", None)
             plan = _limited(
@@ -653,7 +653,8 @@ def _write_files(
             ],
         )
     if "gcode" in groups:
-        assert analysis.gcode is not None  # analysed with the toolpath when G-code is asked for
+        # analysed with the toolpath when G-code is asked for (a part without a program has a note)
+        assert analysis.gcode is not None or not analysis.parts[0].part.program
         programs = [
             (f"cam{r.part.suffix}.ngc", r.gcode.text) for r in (*barrels, *made) if r.gcode is not None
         ]

@@ -6,8 +6,9 @@
 - ``arm`` (samples/barrel_arm.toml): an arm-driven barrel cam, a cylindrical roller on
   an arm of 110 mm about a pivot 100 mm off the barrel's axis, swinging 12° (poly-345
   over 100°) and back;
-- ``RIB``: a rib 14 mm wide straddled by two translating rollers, index 30 mm (modified sine),
-  as code until the design file has a rib.
+- ``RIB`` (samples/barrel_rib.toml): a rib 14 mm wide straddled by two translating rollers,
+  index 30 mm (modified sine), built here in code (tests/test_barrel_rib.py checks that the
+  loader reads the sample to the same objects).
 
 Each case's ``toml`` is its sample's text.
 """
@@ -130,37 +131,5 @@ RIB = BarrelCase(
         kind=BarrelKind.RIB,
         rib_width=14.0,
     ),
-    toml="""\
-# An indexer's rib cam: two rollers straddle a 14 mm rib that indexes them 30 mm along the axis.
-[cam]
-style = "barrel-rib"
-barrel_radius = 70.0   # mm, the rib's top
-length = 110.0
-bore = 40.0
-rib_width = 14.0       # mm along the axis, at the pitch radius, where the follower dwells
-[groove]
-depth = 15.0           # the rib's height
-clearance = 0.05
-[follower]
-type = "translating-roller"
-roller_radius = 8.0
-roller_length = 12.0
-axial_position = 40.0  # mm, the rib's middle at φ = 0
-[[motion]]
-kind = "rise"
-law = "modified-sine"
-angle = 100.0
-lift = 30.0
-[[motion]]
-kind = "dwell"
-angle = 80.0
-[[motion]]
-kind = "return"
-law = "modified-sine"
-angle = 100.0
-lift = 30.0
-[[motion]]
-kind = "dwell"
-angle = 80.0
-""",
+    toml=(ROOT / "samples" / "barrel_rib.toml").read_text(encoding="utf-8"),
 )

@@ -190,8 +190,22 @@ def _barrel_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
         )
     z = barrel["groove_z_mm"]
     rows.append(
-        ("groove along the axis", f"{z['lowest']:.3f} to {z['highest']:.3f} mm (of {barrel['length_mm']:g})")
+        (
+            f"{'rib' if 'rib' in barrel else 'groove'} along the axis",
+            f"{z['lowest']:.3f} to {z['highest']:.3f} mm (of {barrel['length_mm']:g})",
+        )
     )
+    rib = barrel.get("rib")
+    if rib is not None:  # a rib's least width between its exact faces, at its root and its top
+        for where, label in (("bottom", "root"), ("top", "top")):
+            ext = rib["thickness_min"][where]
+            rows.append(
+                (
+                    f"rib thickness at {label}",
+                    f"{ext['value_mm']:.3f} mm least at {ext['angle_deg']:.1f}° "
+                    f"(radius {barrel['stations_mm'][where]:g} mm; width {rib['width_mm']:g} mm as designed)",
+                )
+            )
     slip = barrel["slip"]
     rows.append(
         (

@@ -26,6 +26,7 @@ from camcad.design.tables import (  # the loader's rules, read only
     _BOUNDARY_RULE,
     _LAW_RULES,
     _MOTION_RULES,
+    _RIB_RULES,
     _SECTIONS,
     _TABLE_ANGLE_RULE,
 )
@@ -138,6 +139,7 @@ def design_json_schema() -> dict[str, Any]:
     for section, rules in _SECTIONS.items():
         props = {key: rule_schema(rule) for key, rule in rules.items()}
         props |= {key: rule_schema(rule) for key, rule in _BARREL_RULES.get(section, {}).items()}
+        props |= {key: rule_schema(rule) for key, rule in _RIB_RULES.get(section, {}).items()}
         # a barrel's size is its barrel_radius: base_radius is required on the other styles only
         required = [key for key, rule in rules.items() if rule.required and key != "base_radius"]
         table: dict[str, Any] = {"type": "object", "properties": props, "additionalProperties": False}
@@ -155,25 +157,36 @@ def design_json_schema() -> dict[str, Any]:
         "properties": properties,
         "required": ["cam", "motion"],
         "additionalProperties": False,
-        "allOf": [_barrel_keys()],
+        "allOf": [_barrel_keys(), _barrel_keys(("barrel-rib",), _RIB_RULES, plate=False)],
     }
 
 
-def _barrel_keys() -> dict[str, Any]:
-    """A barrel's keys required on ``style = "barrel"`` and refused on every other style (issue 36)."""
-    barrel = {"properties": {"cam": {"properties": {"style": {"const": "barrel"}}, "required": ["style"]}}}
+def _barrel_keys(
+    styles: tuple[str, ...] = ("barrel", "barrel-rib"),
+    rules: dict[str, dict[str, _Rule]] = _BARREL_RULES,
+    *,
+    plate: bool = True,
+) -> dict[str, Any]:
+    """A barrel's keys required on its ``styles`` and refused on every other style (issue 36).
+
+    With ``plate``, ``base_radius`` the other way round (a barrel's size is its
+    barrel_radius); without, only ``rules`` (a rib's ``rib_width``).
+    """
+    style: dict[str, Any] = {"const": styles[0]} if len(styles) == 1 else {"enum": list(styles)}
+    barrel = {"properties": {"cam": {"properties": {"style": style}, "required": ["style"]}}}
 
     def keys(required: bool) -> dict[str, Any]:
         out: dict[str, Any] = {}
-        for section, rules in _BARREL_RULES.items():
+        for section, table in rules.items():
             if required:
-                out[section] = {"required": [k for k, rule in rules.items() if rule.required]}
+                out[section] = {"required": [k for k, rule in table.items() if rule.required]}
             else:
-                out[section] = {"properties": dict.fromkeys(rules, False)}
+                out[section] = {"properties": dict.fromkeys(table, False)}
         return out
 
     then = keys(True)
-    then["cam"]["properties"] = {"base_radius": False}
     otherwise = keys(False)
-    otherwise["cam"]["required"] = ["base_radius"]
+    if plate:
+        then["cam"]["properties"] = {"base_radius": False}
+        otherwise["cam"]["required"] = ["base_radius"]
     return {"if": barrel, "then": {"properties": then}, "else": {"properties": otherwise}}

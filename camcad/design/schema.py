@@ -36,9 +36,16 @@ from typing import TYPE_CHECKING, Any
 
 from camcad.design.checks import _check_design, _check_follower_keys
 from camcad.design.motion import _finish_motion, _segment
-from camcad.design.rules import MAX_SEGMENTS, MIN_BASE_RADIUS_MM, _convert, _key, _suggest
+from camcad.design.rules import MAX_SEGMENTS, MIN_BASE_RADIUS_MM, _convert, _key, _Rule, _suggest
 from camcad.design.spec import DEG, Design
-from camcad.design.tables import _BARREL_RULES, _SECTIONS, _SPEC_CLASSES, _TOLERANCED, _section
+from camcad.design.tables import (
+    _BARREL_RULES,
+    _RIB_RULES,
+    _SECTIONS,
+    _SPEC_CLASSES,
+    _TOLERANCED,
+    _section,
+)
 from camcad.design.toml_where import _MAX_DIGITS, MAX_NESTING, _find_value, _nesting
 from camcad.dynamics.drive import DriveSpec
 from camcad.dynamics.film import LubricationSpec
@@ -110,7 +117,8 @@ _NOT_ON_A_BARREL = {  # a plate's keys, and why a barrel has none
 def _barrel_table(data: Mapping[str, Any]) -> tuple[Mapping[str, Any], BarrelSpec | None]:
     """A barrel's keys taken out of ``[cam]`` and ``[follower]``, checked; the rest of the design.
 
-    On any other style a barrel key is refused, naming it; on a barrel the
+    On any other style a barrel key is refused, naming it, and ``cam.rib_width``
+    on any style but ``"barrel-rib"`` (which requires it); on a barrel the
     plate's size keys are (its size is ``barrel_radius``, its base circle the
     groove's bottom). The ``[cam]`` table gets ``base_radius`` = ``barrel_radius``
     as a stand-in until the groove's depth is known (:func:`parse_design`).
@@ -119,21 +127,29 @@ def _barrel_table(data: Mapping[str, Any]) -> tuple[Mapping[str, Any], BarrelSpe
     word = cam.get("style", CamStyle.PLATE.value) if isinstance(cam, Mapping) else None
     style = next((s for s in CamStyle if s.value == word), None)  # a bad word: _section names it
     own = family_of(style).own_keys if style is not None else frozenset()
-    barrel = {f"{name}.{key}" for name, rules in _BARREL_RULES.items() for key in rules} <= own
+
+    def keys(rules: dict[str, dict[str, _Rule]]) -> set[str]:
+        return {f"{name}.{key}" for name, table in rules.items() for key in table}
+
+    barrel = keys(_BARREL_RULES) <= own
     values: dict[str, Any] = {}
     rest: dict[str, Any] = dict(data)
-    for name, rules in _BARREL_RULES.items():
-        table = data.get(name, {})
-        if not isinstance(table, Mapping):
-            continue  # _section names the table
-        for key, rule in rules.items():
-            if key in table and not barrel:
-                raise DesignError(f"{name}.{key}", "applies to cam.style = 'barrel' only")
-            if key in table:
-                values[key] = _convert(f"{name}.{key}", rule, table[key])
-            elif barrel and rule.required:
-                raise DesignError(f"{name}.{key}", "is required for a barrel cam (cam.style = 'barrel')")
-        rest[name] = {k: v for k, v in table.items() if k not in rules}
+    for group, owned, where in (
+        (_BARREL_RULES, barrel, "'barrel' or 'barrel-rib'"),
+        (_RIB_RULES, keys(_RIB_RULES) <= own, "'barrel-rib'"),
+    ):
+        for name, rules in group.items():
+            table = rest.get(name, {})
+            if not isinstance(table, Mapping):
+                continue  # _section names the table
+            for key, rule in rules.items():
+                if key in table and not owned:
+                    raise DesignError(f"{name}.{key}", f"applies to cam.style = {where} only")
+                if key in table:
+                    values[key] = _convert(f"{name}.{key}", rule, table[key])
+                elif owned and rule.required:
+                    raise DesignError(f"{name}.{key}", f"is required for cam.style = '{word}'")
+            rest[name] = {k: v for k, v in table.items() if k not in rules}
     if not barrel:
         return data, None
     for path, why in _NOT_ON_A_BARREL.items():

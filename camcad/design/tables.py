@@ -494,3 +494,5 @@ _BARREL_RULES: dict[str, dict[str, _Rule]] = {
         "roller": _Rule("enum", enum=RollerShape),
     },
 }
+# a rib barrel's own key (cam.style = "barrel-rib"), refused on every other style, a groove barrel's too
+_RIB_RULES: dict[str, dict[str, _Rule]] = {"cam": {"rib_width": _Rule("float", required=True, check=_length)}}

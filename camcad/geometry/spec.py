@@ -33,6 +33,7 @@ class CamStyle(enum.Enum):
     CONJUGATE = "conjugate"
     LINEAR = "linear"
     BARREL = "barrel"  # issue 36: a groove round a cylinder (camcad.geometry.families.barrel)
+    BARREL_RIB = "barrel-rib"  # issue 36: a rib round a cylinder, straddled by two rollers (the same module)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -320,14 +320,15 @@ def _conditional_required(root: Mapping[str, Any], data: Mapping[str, Any]) -> d
     """The keys a style requires (the schema's ``allOf`` of if ``cam.style`` = … then/else), per table.
 
     A barrel requires ``barrel_radius`` and ``length`` and every other style
-    ``base_radius``: the JSON Schema states it as one condition on the style.
+    ``base_radius``, a rib ``rib_width``: the JSON Schema states each as a
+    condition on the style (one style, ``const``, or several, ``enum``).
     """
     cam = data.get("cam", {})
     style = cam.get("style", "plate") if isinstance(cam, Mapping) else "plate"
     out: dict[str, set[str]] = {}
     for rule in root.get("allOf", ()):
-        const = rule["if"]["properties"]["cam"]["properties"]["style"]["const"]
-        branch = rule["then"] if style == const else rule["else"]
+        chosen = rule["if"]["properties"]["cam"]["properties"]["style"]
+        branch = rule["then"] if style in chosen.get("enum", [chosen.get("const")]) else rule["else"]
         for section, table in branch["properties"].items():
             out.setdefault(section, set()).update(table.get("required", ()))
     return out

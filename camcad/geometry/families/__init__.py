@@ -5,7 +5,7 @@ See :mod:`camcad.geometry.families.base` for what a family yields.
 
 from __future__ import annotations
 
-from camcad.geometry.families.barrel import BARREL
+from camcad.geometry.families.barrel import BARREL, BARREL_RIB
 from camcad.geometry.families.base import (
     Bar,
     Barrel,
@@ -47,6 +47,7 @@ FAMILIES: dict[CamStyle, CamFamily] = {
     CamStyle.CONJUGATE: CONJUGATE,
     CamStyle.LINEAR: LINEAR,
     CamStyle.BARREL: BARREL,
+    CamStyle.BARREL_RIB: BARREL_RIB,
 }
 """Each ``cam.style`` and its family."""
 

@@ -19,6 +19,21 @@ barrel's exact one at the pitch station (tan α = s′/t_p for a translating
 cylinder), its profile's curvature sets the Hertz contact, and an arm's
 lever is its length. The figures at the groove's bottom and top and the
 roller's slip are this family's ``barrel`` section.
+
+The rib (``cam.style = "barrel-rib"``, :data:`BARREL_RIB`): the same family
+with :attr:`~camcad.geometry.barrel.BarrelKind.RIB`, a rib of ``rib_width``
+standing ``[groove] depth`` high on the core, straddled by two rollers
+±h = ±(w/2 + r_f + c/2) off the follower's pitch path
+(:func:`~camcad.geometry.barrel.rib_rollers`). Each face is the 3-D envelope
+of one roller, the material on the same side of its roller as a groove's
+wall (the rib's upper face is the +h roller's lower wall), so for a
+translating follower each roller's developed pitch line is the follower's
+moved by ±h along the barrel's axis, with the same pressure angle and
+curvature: the developed cam, its positive drive and its flanks are the
+groove's (for an arm the pressure angle is the larger of the two rollers'
+and the lever the roller's, √(l² + h²)). A rib's barrel gets no ``cam.ngc``
+(the 4-axis plan machines a groove; a rib needs the barrel's whole surface
+round it cut away), which a note says.
 """
 
 from __future__ import annotations
@@ -33,13 +48,15 @@ import numpy as np
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.errors import DesignError
 from camcad.extremes import SIDE_WORDS, Extreme, extremes_rows
+from camcad.findings import Finding, Severity
 from camcad.geometry.barrel import (
     BarrelFollower,
+    BarrelKind,
     BarrelOptions,
     OscillatingBarrelRoller,
     TranslatingBarrelRoller,
-    WallSide,
-    barrel_walls,
+    barrel_faces,
+    face_rollers,
     roller_slip,
 )
 from camcad.geometry.barrel_limits import barrel_limits
@@ -50,7 +67,7 @@ from camcad.geometry.families.base import Barrel, Drive, FamilyOptions, Part, Pa
 from camcad.geometry.groove import roller_flank_offsets
 from camcad.motion.program import Side
 
-__all__ = ["BARREL", "BarrelCam", "BarrelFamily", "barrel_of"]
+__all__ = ["BARREL", "BARREL_RIB", "BarrelCam", "BarrelFamily", "barrel_of"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -92,7 +109,9 @@ class BarrelCam(Cam):
         alpha = self._alpha(m)
         lever = None
         if isinstance(self.barrel_follower, OscillatingBarrelRoller):  # pivot → roller axis: the arm
-            lever = np.full(np.shape(alpha), self.barrel_follower.arm_length)
+            # a rib's roller rides on a yoke h off the arm's end: its lever is √(l² + h²)
+            arm = math.hypot(self.barrel_follower.arm_length, self.barrel_options.rib_offset)
+            lever = np.full(np.shape(alpha), arm)
             readonly(lever)
         position = self.roller_radius * np.sin(alpha)  # where the contact sits on the roller, across it
         readonly(position)
@@ -106,10 +125,10 @@ class BarrelCam(Cam):
         )
 
     def _alpha(self, motion: Any) -> FloatArray:
-        """The barrel's exact pressure angle at the pitch station (3-D for a cone), (n,) [rad]."""
+        """The exact pressure angle at the pitch station [rad] (3-D for a cone; a rib: the larger)."""
         station = np.array([self.barrel_options.pitch_station])
         out: FloatArray = (
-            barrel_walls(motion, self.barrel_follower, self.barrel_options, station)
+            barrel_faces(motion, self.barrel_follower, self.barrel_options, station)
             .pressure_angle[:, 0]
             .copy()
         )
@@ -117,7 +136,7 @@ class BarrelCam(Cam):
         return out
 
     def pressure_angle(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
-        """The pressure angle at the pitch station [rad] (:func:`camcad.geometry.barrel.barrel_walls`)."""
+        """The pressure angle at the pitch station [rad] (:func:`camcad.geometry.barrel.barrel_faces`)."""
         return self._alpha(self.motion(phi, side=side))
 
     def contact_offset(self, phi: ArrayLike, *, side: Side = "right") -> FloatArray:
@@ -128,7 +147,11 @@ class BarrelCam(Cam):
 
 
 def _barrel_objects(cam: Cam, options: FamilyOptions) -> tuple[BarrelFollower, BarrelOptions]:
-    """The barrel follower and options a design states (its follower's kind decides slide or arm)."""
+    """The barrel follower and options a design states (its follower's kind decides slide or arm).
+
+    A ``rib_width`` makes it a rib (:attr:`~camcad.geometry.barrel.BarrelKind.RIB`); the
+    schema allows it on ``cam.style = "barrel-rib"`` only, and requires it there.
+    """
     spec = options.barrel
     if spec is None:
         raise DesignError("cam.barrel_radius", "is required for a barrel cam (mm, the barrel's outer radius)")
@@ -150,6 +173,8 @@ def _barrel_objects(cam: Cam, options: FamilyOptions) -> tuple[BarrelFollower, B
         bore=options.bore,
         clearance=options.groove.clearance,
         roller=spec.roller,
+        kind=BarrelKind.GROOVE if spec.rib_width is None else BarrelKind.RIB,
+        rib_width=0.0 if spec.rib_width is None else spec.rib_width,
     )
     return follower, barrel
 
@@ -168,22 +193,25 @@ def barrel_of(cam: Cam, options: FamilyOptions) -> Barrel:
 
 
 class BarrelFamily:
-    """A barrel cam: one part, the cylinder with its groove."""
+    """A barrel cam: one part, the cylinder with its groove (or, ``kind`` RIB, with its rib)."""
 
-    name = "barrel"
-    table = "groove"  # the groove's depth and clearance, as a groove cam's
-    own_keys = frozenset(
-        {
+    table = "groove"  # the groove's depth and clearance, as a groove cam's (a rib: its height)
+    needs_roller = True
+    one_plate = False
+    plates = False  # a cylinder: no FE check of a plate
+
+    def __init__(self, kind: BarrelKind = BarrelKind.GROOVE) -> None:
+        self.kind = kind
+        self.rib = kind is BarrelKind.RIB
+        self.name = "barrel rib" if self.rib else "barrel"
+        keys = {
             "cam.barrel_radius",
             "cam.length",
             "follower.axial_position",
             "follower.roller_length",
             "follower.roller",
         }
-    )
-    needs_roller = True
-    one_plate = False
-    plates = False  # a cylinder: no FE check of a plate
+        self.own_keys = frozenset(keys | {"cam.rib_width"} if self.rib else keys)
 
     def check(
         self, options: FamilyOptions, *, base_radius: float, roller_radius: float, thickness: float
@@ -195,13 +223,17 @@ class BarrelFamily:
             raise DesignError(
                 "cam.barrel_radius", "is required for a barrel cam (mm, the barrel's outer radius)"
             )
+        if self.rib and options.barrel.rib_width is None:
+            raise DesignError("cam.rib_width", "is required for cam.style = 'barrel-rib' (mm, > 0)")
+        if not self.rib and options.barrel.rib_width is not None:
+            raise DesignError("cam.rib_width", "applies to cam.style = 'barrel-rib' only")
 
     def check_cam(self, cam: Callable[[], Cam], options: FamilyOptions) -> None:
-        """The barrel, groove, roller and arm can be made (:func:`barrel_of`)."""
+        """The barrel, groove (or rib), roller and arm can be made (:func:`barrel_of`)."""
         barrel_of(cam(), options)
 
     def parts(self, cam: Cam, options: FamilyOptions) -> tuple[Part, ...]:
-        """The barrel with its groove; its cam is the groove developed at the pitch station."""
+        """The barrel with its groove or rib; its cam is the groove developed at the pitch station."""
         barrel = barrel_of(cam, options)
         developed = BarrelCam(
             program=cam.program,
@@ -212,10 +244,13 @@ class BarrelFamily:
             barrel_follower=barrel.follower,
             barrel_options=barrel.options,
         )
-        return (Part(cam=developed, barrel=barrel, checks=(_BarrelCheck(barrel),)),)
+        # a rib's barrel has no 4-axis program (module notes): the part says so and has none planned
+        unplanned = _RIB_UNPLANNED if self.rib else None
+        check = _BarrelCheck(barrel, unplanned)
+        return (Part(cam=developed, barrel=barrel, checks=(check,), program=not self.rib),)
 
     def drive(self, roller_radius: float, options: FamilyOptions) -> Drive:
-        """The groove's two walls drive the roller both ways, with the groove's play."""
+        """The groove's two walls (a rib's two faces) drive the roller(s) both ways, with the play c."""
         clearance = options.groove.clearance
         return Drive(
             positive_drive=True,
@@ -240,8 +275,22 @@ class BarrelFamily:
         return out
 
     def caption(self, parts: Sequence[Part]) -> str:
-        """The roller runs in the groove round the barrel."""
+        """The roller runs in the groove round the barrel (the two rollers straddle the rib)."""
+        if self.rib:
+            return " Two rollers straddle the rib round the barrel, shown developed at their pitch station."
         return " The roller runs in the groove round the barrel, shown developed at its pitch station."
+
+
+_RIB_UNPLANNED = Finding(
+    kind="no program",
+    severity=Severity.NOTE,
+    field="cam.style",
+    message=(
+        'cam.style: "barrel-rib" gets no cam.ngc: the 4-axis program machines a groove, and a rib needs '
+        "the barrel's whole surface round it cut away, which is not planned; "
+        "cam.step, cam.stl and profile.dxf are written"
+    ),
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -249,10 +298,12 @@ class _BarrelCheck:
     """The barrel's own findings (a wall that loops at the groove's bottom)."""
 
     barrel: Barrel
+    unplanned: Finding | None = None  # a note: why the part has no G-code program
 
     @property
     def findings(self) -> tuple[Any, ...]:
-        return self.barrel.limits.findings
+        note = () if self.unplanned is None else (self.unplanned,)
+        return (*self.barrel.limits.findings, *note)
 
     @property
     def radius_margin(self) -> float:
@@ -279,8 +330,8 @@ def _barrel_summary(barrel: Barrel) -> dict[str, Any]:
         "barrel_radius_mm": o.barrel_radius,
         "length_mm": o.length,
         "bore_mm": o.bore,
-        "groove_depth_mm": o.depth,
-        "groove_width_mm": 2.0 * o.roller_radius + o.clearance,
+        "groove_depth_mm": o.depth,  # a rib: its height
+        "groove_width_mm": 2.0 * o.roller_radius + o.clearance,  # a rib: the gap each roller runs in
         "roller": o.roller.value,
         "roller_length_mm": o.roller_length,
         "stations_mm": {"bottom": o.bottom_radius, "pitch": o.pitch_station, "top": o.barrel_radius},
@@ -294,8 +345,16 @@ def _barrel_summary(barrel: Barrel) -> dict[str, Any]:
             for where, (up, low) in lim.stretch_min.items()
         },
         "groove_z_mm": {"lowest": lim.z_range[0].value, "highest": lim.z_range[1].value},
-        "undercut": bool(lim.findings),
+        "undercut": any(f.kind == "groove undercut" for f in lim.findings),
     }
+    if o.kind is BarrelKind.RIB:  # its width as designed, and its least width between the exact faces
+        out["rib"] = {
+            "width_mm": o.rib_width,
+            "roller_offset_mm": o.rib_offset,
+            "thickness_min": {
+                where: _extreme(ext, unit="mm") for where, ext in lim.rib_thickness_min.items()
+            },
+        }
     out["slip"] = _slip_summary(barrel)
     return out
 
@@ -317,8 +376,8 @@ def _slip_summary(barrel: Barrel) -> dict[str, Any]:
     def rows(phi: FloatArray, side: Side) -> FloatArray:
         motion = barrel.program.evaluate(phi, side=side)
         out = np.zeros((2, np.size(phi)))
-        for wall in (WallSide.UPPER, WallSide.LOWER):
-            slip = roller_slip(motion, barrel.follower, o, stations, wall)
+        for roller, wall in face_rollers(barrel.follower, o):  # a rib: each face's own roller
+            slip = roller_slip(motion, roller, o, stations, wall)
             out[0] = np.maximum(out[0], np.max(np.abs(slip.across), axis=1))
             out[1] = np.maximum(out[1], np.max(np.abs(slip.along), axis=1))
         return out
@@ -332,3 +391,4 @@ def _slip_summary(barrel: Barrel) -> dict[str, Any]:
 
 
 BARREL = BarrelFamily()
+BARREL_RIB = BarrelFamily(BarrelKind.RIB)

@@ -51,7 +51,9 @@ class BarrelSpec:
 
     ``barrel_radius`` R [mm] (outer) and ``length`` [mm] along its axis
     (``[cam]``); ``axial_position`` z0 [mm], the roller's axis at φ = 0,
-    ``roller`` its shape and ``roller_length`` ℓ [mm] (``[follower]``).
+    ``roller`` its shape and ``roller_length`` ℓ [mm] (``[follower]``);
+    ``rib_width`` w [mm] (``[cam]``): a rib's width along the axis at the
+    pitch station, None for a groove (``cam.style = "barrel-rib"`` requires it).
     """
 
     barrel_radius: float
@@ -59,6 +61,7 @@ class BarrelSpec:
     axial_position: float
     roller_length: float
     roller: RollerShape = RollerShape.CYLINDRICAL
+    rib_width: float | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -201,6 +204,9 @@ class Part:
         developed at the roller's pitch station.
     checks
         The family's own checks of the part (a groove's flank checks).
+    program
+        False for a part made without a G-code program (a rib's barrel): no
+        ``cam.ngc`` is planned; its checks carry a note saying why.
     """
 
     cam: Cam
@@ -212,6 +218,7 @@ class Part:
     bar: Bar | None = None
     barrel: Barrel | None = None
     checks: tuple[PartCheck, ...] = ()
+    program: bool = True
 
     @property
     def flanks(self) -> tuple[Flank, ...]:
