@@ -32,7 +32,6 @@ class Knob(enum.Enum):
     CAM_LENGTH = "cam length"
     BORE = "bore"
     STROKE_LENGTH = "stroke length"
-    LINEAR_STROKE_LENGTH = "linear cam's stroke length"
     CAM_STYLE = "cam style"
     CONJUGATE_ANGLE = "angle between the conjugate rollers"
     GROOVE_DEPTH = "groove depth"

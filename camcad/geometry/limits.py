@@ -345,7 +345,7 @@ def analyse_geometry(
     undercut_finding = Finding(
         kind="undercut" if cam.has_pitch_curve else "cusp",
         severity=Severity.HARD,
-        field=Knob.BASE_RADIUS if cam.closed else Knob.LINEAR_STROKE_LENGTH,
+        field=Knob.BASE_RADIUS if cam.closed else Knob.STROKE_LENGTH,
         message=err.message,
         field_first=True,
         angle=undercut.worst_angle,
@@ -652,7 +652,7 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
             phi_range=uc.ranges[0],
             worst=uc.worst,
             suggested_base_radius=None,
-            field=Knob.LINEAR_STROKE_LENGTH,
+            field=Knob.STROKE_LENGTH,
         )
     sized = min_base_radius(cam, min_curvature_radius=min_curvature_radius)
     suggestion = math.ceil(sized.base_radius / _SUGGEST_ROUND_MM) * _SUGGEST_ROUND_MM

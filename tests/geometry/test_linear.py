@@ -23,6 +23,7 @@ from camcad.errors import EXIT_INVALID, DesignError, exit_code
 from camcad.findings import Severity
 from camcad.geometry.followers import OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller
 from camcad.geometry.linear import LinearOptions, linear_limits, linear_state
+from camcad.knobs import Knob
 from camcad.motion.laws import make_law
 from camcad.motion.program import MotionProgram
 from camcad.motion.segments import SegmentKind, SegmentSpec
@@ -115,7 +116,7 @@ def test_limits_true_extremes_and_undercut():
     assert not lim.findings
     short = linear_limits(prog, follower, LinearOptions(stroke_length=90.0))
     assert [f.severity for f in short.findings] == [Severity.HARD]
-    assert short.findings[0].field == "cam.stroke_length"
+    assert short.findings[0].field is Knob.STROKE_LENGTH
     assert short.pitch_convex_min.value < 10.0
 
 
