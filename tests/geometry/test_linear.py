@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.spatial import cKDTree
 
+from camcad.design.paths import path_of
 from camcad.errors import EXIT_INVALID, DesignError, exit_code
 from camcad.findings import Severity
 from camcad.geometry.followers import OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller
@@ -132,12 +133,12 @@ def test_limits_true_extremes_and_undercut():
         (
             TranslatingRoller(base_radius=30.0, roller_radius=10.0),
             LinearOptions(stroke_length=0.0),
-            "cam.stroke_length",
+            "linear.stroke_length",
         ),
         (
             TranslatingRoller(base_radius=30.0, roller_radius=10.0),
             LinearOptions(stroke_length=math.inf),
-            "cam.stroke_length",
+            "linear.stroke_length",
         ),
     ],
     ids=["translating-flat", "oscillating-flat", "zero-stroke", "infinite-stroke"],
@@ -145,7 +146,7 @@ def test_limits_true_extremes_and_undercut():
 def test_bad_input_names_the_field(follower, opt, field):
     with pytest.raises(DesignError) as err:
         linear_state(program().evaluate(PHI), follower, opt)
-    assert err.value.path == field
+    assert path_of(err.value.path) == field
     assert exit_code(err.value) == EXIT_INVALID
 
 
