@@ -17,6 +17,7 @@ import numpy as np
 from camcad._typing import FloatArray
 from camcad._version import __version__
 from camcad.design import Design
+from camcad.design.paths import named_findings
 from camcad.dynamics import DynamicsResult
 from camcad.extremes import SIDE_WORDS, Side, extremes_rows
 from camcad.findings import Finding
@@ -80,7 +81,9 @@ class PartResult:
         """Its geometry's, family checks', dynamics', FE's and duty's findings; a later part's name theirs."""
         fea = self.fea.findings if self.fea is not None else ()
         duty = self.duty.findings if self.duty is not None else ()
-        found = (*self.geometry.findings, *self.part.findings, *self.dynamics.findings, *fea, *duty)
+        found = named_findings(
+            (*self.geometry.findings, *self.part.findings, *self.dynamics.findings, *fea, *duty)
+        )
         if not self.part.label:
             return found
         return tuple(replace(f, message=f"{self.part.label}: {f.message}") for f in found)
@@ -172,7 +175,7 @@ class Analysis:
             *(self.drive.findings if self.drive is not None else ()),
             *(self.vibration.findings if self.vibration is not None else ()),
         )
-        return tuple(sorted(found, key=lambda f: f.rank))
+        return tuple(sorted(named_findings(found), key=lambda f: f.rank))
 
     @property
     def violations(self) -> list[str]:

@@ -9,7 +9,10 @@ a limit the user cannot ignore, such as undercut or gouge (exit 3).
 
 Every error carries the design field it concerns as data, ``field`` (a TOML
 path such as ``cam.base_radius``, an option such as ``--output``, or empty),
-set by the caller that knows the path; its text names it (in front,
+set by the caller that knows the path; a stage below the design layer names a
+:class:`~camcad.knobs.Knob` (or :class:`~camcad.knobs.TableKey`) instead, which the
+design layer turns into the path where the error leaves the core
+(:func:`camcad.design.paths.named_error`); its text names it (in front,
 ``"cam.base_radius: undercut at …"``, unless the message names it already),
 so nothing reads it back out of a message.
 """
@@ -19,6 +22,8 @@ from __future__ import annotations
 import errno
 import os
 import unicodedata
+
+from camcad.knobs import Blame
 
 __all__ = [
     "EXIT_INTERRUPTED",
@@ -79,14 +84,15 @@ class CamcadError(Exception):
     *args
         The message (as for :class:`Exception`).
     field
-        The design field (TOML path) or command-line option the error
+        The design field (TOML path, or a stage's :class:`~camcad.knobs.Knob`
+        or :class:`~camcad.knobs.TableKey`) or command-line option the error
         concerns, empty when none; the text starts with it.
     """
 
     exit_code: int = EXIT_UNEXPECTED
-    field: str = ""
+    field: str | Blame = ""
 
-    def __init__(self, *args: object, field: str = "") -> None:
+    def __init__(self, *args: object, field: str | Blame = "") -> None:
         super().__init__(*args)
         self.field = field
 
@@ -97,7 +103,7 @@ class CamcadError(Exception):
         limit's message that names its field for the report too).
         """
         text = super().__str__()
-        if self.field and self.field not in text:
+        if self.field and str(self.field) not in text:
             text = f"{self.field}: {text}"
         return printable(text)
 
@@ -107,7 +113,7 @@ class CamcadError(Exception):
         text = str(self.args[0]) if self.args else ""
         return text.removeprefix(f"{self.field}: ") if self.field else text
 
-    def with_field(self, field: str) -> CamcadError:
+    def with_field(self, field: str | Blame) -> CamcadError:
         """Name ``field`` unless a field is named already (a caller that knows the TOML path)."""
         if not self.field:
             self.field = field
@@ -126,7 +132,7 @@ class DesignError(CamcadError, ValueError):
         What is wrong, with the value and what is allowed.
     """
 
-    def __init__(self, path: str, message: str) -> None:
+    def __init__(self, path: str | Blame, message: str) -> None:
         super().__init__(message, field=path)
 
     def __str__(self) -> str:
@@ -135,7 +141,7 @@ class DesignError(CamcadError, ValueError):
         return printable(f"{self.field}: {text}" if self.field else text)
 
     @property
-    def path(self) -> str:
+    def path(self) -> str | Blame:
         """The field path (``field``; this older name stays for callers that use it)."""
         return self.field
 
@@ -219,7 +225,7 @@ class UndercutError(DesignLimitError):
         phi_range: tuple[float, float],
         worst: float,
         suggested_base_radius: float | None,
-        field: str = "",
+        field: str | Blame = "",
     ) -> None:
         super().__init__(message, field=field)
         self.phi_range = phi_range
@@ -231,7 +237,7 @@ class GougeError(DesignLimitError):
     """The milling tool is larger than a concave radius of the profile."""
 
     def __init__(
-        self, message: str, *, phi_range: tuple[float, float], max_tool_radius: float, field: str = ""
+        self, message: str, *, phi_range: tuple[float, float], max_tool_radius: float, field: str | Blame = ""
     ) -> None:
         super().__init__(message, field=field)
         self.phi_range = phi_range
@@ -241,7 +247,9 @@ class GougeError(DesignLimitError):
 class FitError(DesignLimitError):
     """The NURBS fit cannot meet the tolerance within the control-point budget (a hard limit)."""
 
-    def __init__(self, message: str, *, best_error: float, control_point_count: int, field: str = "") -> None:
+    def __init__(
+        self, message: str, *, best_error: float, control_point_count: int, field: str | Blame = ""
+    ) -> None:
         super().__init__(message, field=field)
         self.best_error = best_error
         self.control_point_count = control_point_count

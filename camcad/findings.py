@@ -25,6 +25,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from camcad.knobs import Blame
+
 __all__ = ["Finding", "Severity"]
 
 
@@ -47,9 +49,18 @@ class Finding:
     severity
         :class:`Severity`.
     field
-        The design field that controls it, e.g. ``"cam.base_radius"``.
+        The design field that controls it, e.g. ``"cam.base_radius"``; a
+        stage below the design layer names a :class:`~camcad.knobs.Knob`
+        (or :class:`~camcad.knobs.TableKey`),
+        which the design layer turns into the path
+        (:func:`camcad.design.paths.named_finding`).
     message
         One sentence for a person: what, where, how much, and a way out.
+    field_first
+        Whether the message is shown with its field in front
+        (``"cam.base_radius: undercut at …"``): a stage that names a knob
+        leaves the path out of its text and sets this; naming the finding
+        puts the path in front and clears it.
     angle
         Cam angle where it is worst [rad], or ``None``.
     value, limit
@@ -60,8 +71,9 @@ class Finding:
 
     kind: str
     severity: Severity
-    field: str
+    field: str | Blame
     message: str
+    field_first: bool = False
     angle: float | None = None
     value: float | None = None
     limit: float | None = None
@@ -87,12 +99,12 @@ class Finding:
         return {
             "kind": self.kind,
             "severity": self.severity.value,
-            "field": self.field,
+            "field": str(self.field),
             "angle_deg": None if self.angle is None else round(math.degrees(self.angle), 6),
             "value": self.value,
             "limit": self.limit,
             "unit": self.unit,
-            "message": self.message,
+            "message": f"{self.field}: {self.message}" if self.field_first else self.message,
         }
 
 

@@ -23,6 +23,7 @@ import numpy as np
 
 from camcad.analysis import Analysis, PartResult, motion_summary
 from camcad.design import Design, load_design
+from camcad.design.paths import named_error, named_finding, named_findings, names_its_errors, path_of
 from camcad.dynamics import DynamicsResult, analyse_dynamics
 from camcad.dynamics.spec import DynamicsSetup
 from camcad.errors import DesignLimitError, ExportError, FitError, GougeError, UsageError
@@ -71,6 +72,7 @@ OUTPUT_GROUPS: dict[str, tuple[str, ...]] = {
 """What ``build --only`` selects; ``summary.json`` is always written."""
 
 
+@names_its_errors
 def load(path: str | Path) -> Project:
     """Read and validate a design file; ``camcad.load(path).analyse()`` runs it."""
     return Project(design=load_design(path))
@@ -109,6 +111,7 @@ def _timed(timings: dict[str, float], progress: Progress | None, name: str, fn: 
     return result
 
 
+@names_its_errors
 def analyse(
     design: Design,
     *,
@@ -150,7 +153,7 @@ def analyse(
     vibration = None
     if design.vibration is not None:  # issue 34: the elastic train; a polydyne cam is cut from its lift c
         vibration = _timed(timings, progress, "vibration", lambda: _vibration(design, cam))
-        stop = [f for f in vibration.findings if f.hard]  # the follower leaves a spring-loaded cam
+        stop = [named_finding(f) for f in vibration.findings if f.hard]  # the follower leaves the cam
         if stop and strict:
             raise DesignLimitError(stop[0].message, field=stop[0].field)
         if vibration.compensated is not None:
@@ -179,7 +182,7 @@ def analyse(
     ]
     if hard and strict:
         if geometries[0].undercut is not None:
-            raise undercut_error(geometries[0], min_curvature_radius=design.min_curvature_radius)
+            raise named_error(undercut_error(geometries[0], min_curvature_radius=design.min_curvature_radius))
         raise DesignLimitError(hard[0].message, field=hard[0].field)
     setup = design.dynamics_setup()
 
@@ -216,7 +219,10 @@ def analyse(
     later: list[Finding] = []  # hard limits found by the fit and the toolpath plan
     if fit and not hard:
         fit_curve = partial(
-            fit_cam_profile, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
+            fit_cam_profile,
+            tolerance=design.fit.tolerance,
+            max_control_points=design.fit.max_control_points,
+            name_of=path_of,
         )
 
         def fit_part(result: PartResult) -> PartResult:  # its outline, then its further curves (flanks)
@@ -333,9 +339,10 @@ def _vibration_of(
 
 def _labelled(part: Part, findings: Iterable[Finding]) -> list[Finding]:
     """``findings`` of ``part``, their messages named by its label when it has one ("second plate: …")."""
+    named = named_findings(findings)  # the path leads the message, then the label leads both
     if not part.label:
-        return list(findings)
-    return [replace(f, message=f"{part.label}: {f.message}") for f in findings]
+        return list(named)
+    return [replace(f, message=f"{part.label}: {f.message}") for f in named]
 
 
 def _fea_check(
@@ -382,7 +389,7 @@ def _limited(
     try:
         return _timed(timings, progress, stage, run)
     except error as err:
-        err.with_field(field)  # the stage's own field when it named none
+        named_error(err.with_field(field))  # the stage's own field when it named none
         if strict:
             raise
         found.append(Finding(kind=kind, severity=Severity.HARD, field=err.field, message=str(err)))
@@ -401,6 +408,7 @@ def _groups(only: Iterable[str] | None) -> set[str]:
     return chosen
 
 
+@names_its_errors
 def build(
     design: Design,
     outdir: str | Path,
@@ -723,6 +731,7 @@ def _fitted(result: PartResult) -> ProfileFit:
     return result.fit
 
 
+@names_its_errors
 def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
     """motion.csv, profile.csv, dynamics.csv, points.csv, lift.csv and the optional tables into ``folder``."""
     from camcad.export.tables import (

@@ -33,7 +33,20 @@ PACKAGE = ROOT / "camcad"
 
 # Layer of each top-level name under camcad/ (a module or a package), bottom first.
 LAYER_ORDER: tuple[frozenset[str], ...] = (
-    frozenset({"_typing", "_version", "_lazy", "errors", "angles", "extremes", "findings", "roots", "units"}),
+    frozenset(
+        {
+            "_typing",
+            "_version",
+            "_lazy",
+            "errors",
+            "angles",
+            "extremes",
+            "findings",
+            "knobs",
+            "roots",
+            "units",
+        }
+    ),
     frozenset({"motion"}),
     frozenset({"geometry"}),
     frozenset({"dynamics"}),
@@ -521,3 +534,118 @@ def test_private_rule_flags_names_modules_and_attributes_across_packages():
         "camcad.export.d:3 -> camcad.design.tables._SECTIONS",
         "camcad.export.e:1 -> camcad.toolpath._pieces.Piece",
     ]
+
+
+# No stage below the design layer writes a TOML path (``"cam.base_radius"``, ``f"drive.{name}"``): it
+# names a ``camcad.knobs.Knob``, which ``camcad.design.paths`` maps to the path where errors and
+# findings leave the core (issue 33). A follower's and a cam family's module declare their own
+# schema keys, so theirs are their own data.
+STAGES = ("motion", "geometry", "dynamics", "inspect", "fea", "fit", "toolpath", "export")
+OWN_SCHEMA = (PACKAGE / "geometry" / "followers", PACKAGE / "geometry" / "families")
+FILE_SUFFIXES = frozenset(
+    {"step", "stl", "ngc", "dxf", "csv", "json", "html", "svg", "png", "py", "toml", "txt"}
+)
+
+
+@functools.cache
+def _toml_path_pattern() -> re.Pattern[str]:
+    from camcad.design.tables import _SECTIONS
+
+    sections = "|".join(sorted(_SECTIONS, key=len, reverse=True))
+    return re.compile(rf"(?<![\w.])({sections})\.([A-Za-z_]\w*|$)")
+
+
+def toml_path_literals(tree: ast.Module) -> list[str]:
+    """The TOML paths a module's code writes (string constants, f-string parts), as ``line: 'path'``.
+
+    A table's name before a formatted key (``f"drive.{name}"``) counts. Docstrings (of a module,
+    class, function or attribute) are prose, not code, and a file name (``cam.step``) is not a path.
+    """
+    skip = _docstrings(tree) | {
+        id(node.value)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
+    }
+    keyed: set[int] = set()  # f-string parts followed by a formatted value: "drive." counts there
+    for node in ast.walk(tree):
+        if isinstance(node, ast.JoinedStr):
+            keyed |= {
+                id(part)
+                for part, after in zip(node.values, node.values[1:], strict=False)
+                if isinstance(after, ast.FormattedValue)
+            }
+    out: list[str] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in skip:
+            for hit in _toml_path_pattern().finditer(node.value):
+                if hit.group(2) not in FILE_SUFFIXES and (hit.group(2) or id(node) in keyed):
+                    out.append(f"{node.lineno}: {hit.group(0)!r}")
+    return out
+
+
+def stage_toml_paths(package: Path) -> list[str]:
+    """Every TOML path written in the stage packages under ``package`` (a camcad tree)."""
+    found = []
+    for stage in STAGES:
+        for path in sorted((package / stage).rglob("*.py")):
+            if any(
+                home.name == path.parent.name and path.parent.parent.name == "geometry" for home in OWN_SCHEMA
+            ):
+                continue
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+            found += [f"{path.relative_to(package.parent)}:{hit}" for hit in toml_path_literals(tree)]
+    return found
+
+
+def test_no_stage_writes_a_toml_path():
+    found = stage_toml_paths(PACKAGE)
+    assert not found, "name a camcad.knobs.Knob (design/paths.py maps it):\n" + "\n".join(found)
+
+
+def test_toml_path_scan_flags_literals_and_f_strings_but_not_prose_or_files():
+    source = (
+        '"""Raise cam.base_radius (a docstring is prose)."""\n'
+        "from camcad.errors import DesignError\n"
+        "def f(name, x):\n"
+        '    """Says gcode.tool_diameter."""\n'
+        '    open("cam.step")\n'
+        "    if x:\n"
+        '        raise DesignError("follower.roller_radius", "too small")\n'
+        '    raise DesignError(f"drive.{name}", f"use a larger groove.depth than {x}")\n'
+        "LIMIT = 3\n"
+        '"""An attribute docstring may end with the cam."""\n'
+        'WORDS = "a note about the cam."\n'
+    )
+    assert toml_path_literals(ast.parse(source)) == [
+        "7: 'follower.roller_radius'",
+        "8: 'drive.'",
+        "8: 'groove.depth'",
+    ]
+
+
+def test_every_knob_has_one_toml_path_the_schema_knows():
+    from camcad.design.paths import PATHS
+    from camcad.design.tables import _BARREL_RULES, _SECTIONS
+    from camcad.knobs import Knob
+
+    assert set(PATHS) == set(Knob)
+    assert len(set(PATHS.values())) == len(PATHS)  # one knob per path
+    unknown = []
+    for knob, path in PATHS.items():
+        table, _, key = path.partition(".")
+        if not key:
+            assert table in _SECTIONS, knob  # a table whose keys a stage names itself (TableKey)
+        elif key not in _SECTIONS.get(table, {}) and key not in _BARREL_RULES.get(table, {}):
+            unknown.append(path)
+    assert sorted(unknown) == sorted(KNOWN_PATHS_OUTSIDE_THE_SCHEMA)
+
+
+# Paths the stages name that no schema rule states (the list only shrinks): options a stage has
+# that the design file does not set yet.
+KNOWN_PATHS_OUTSIDE_THE_SCHEMA = (
+    "cam.rib_width",  # geometry/barrel.py: a barrel's rib width, not yet a [cam] key
+    "gcode.stepover",  # toolpath/barrel.py: the barrel's roughing, not yet [gcode] keys
+    "gcode.rough_diameter",
+    "gcode.stock",
+    "tolerance.weights",  # inspect/tolerance.py: the study's weights, given by the API, not the file
+)

@@ -22,6 +22,7 @@ from typing import Any
 
 from camcad import _exit_interrupted
 from camcad.cli.args import build_parser
+from camcad.design.paths import named_error
 from camcad.errors import (
     EXIT_INTERRUPTED,
     EXIT_PIPE_CLOSED,
@@ -156,10 +157,10 @@ def _run(argv: Sequence[str] | None) -> int:
         _silence_stdout()
         return EXIT_PIPE_CLOSED
     except DesignLimitError as err:
-        _say("design limit", str(err))
+        _say("design limit", str(named_error(err)))
         return exit_code(err)
     except CamcadError as err:
-        _say("error", str(err))
+        _say("error", str(named_error(err)))
         return exit_code(err)
     except OSError as err:
         where = f": {os.fsdecode(err.filename)}" if err.filename else ""

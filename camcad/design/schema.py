@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 from camcad.design.checks import _check_design, _check_follower_keys
 from camcad.design.motion import _finish_motion, _segment
+from camcad.design.paths import names_its_errors
 from camcad.design.rules import MAX_SEGMENTS, MIN_BASE_RADIUS_MM, _convert, _key, _Rule, _suggest
 from camcad.design.spec import DEG, Design
 from camcad.design.tables import (
@@ -160,6 +161,7 @@ def _barrel_table(data: Mapping[str, Any]) -> tuple[Mapping[str, Any], BarrelSpe
     return rest, BarrelSpec(**values)
 
 
+@names_its_errors
 def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path | None = None) -> Design:
     """Validate a design given as a TOML-like mapping.
 
@@ -231,6 +233,7 @@ def parse_design(data: Mapping[str, Any], *, source: str = "", confine_to: Path 
     return design
 
 
+@names_its_errors
 def parse_tolerance(table: Any, design: Design) -> ToleranceSpec:
     """The ``[tolerance]`` table (issue 38) of a validated design, checked against its follower.
 
@@ -304,6 +307,7 @@ def parse_tolerance(table: Any, design: Design) -> ToleranceSpec:
     return ToleranceSpec(tolerances=tuple(tolerances), keys=tuple(keys), **extra)
 
 
+@names_its_errors
 def load_design(path: str | Path, *, confine_to: Path | None = None) -> Design:
     """Read and validate a TOML design file (``confine_to``: see :func:`parse_design`).
 

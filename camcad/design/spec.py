@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+from camcad.design.paths import path_of
 from camcad.dynamics.drive import DriveSpec
 from camcad.dynamics.film import LubricationSpec
 from camcad.dynamics.life import LifeSpec
@@ -70,7 +71,7 @@ class Design:
     dxf: DxfSpec = field(default_factory=DxfSpec)
     mesh: MeshSpec = field(default_factory=MeshSpec)
     tables: TablesSpec = field(default_factory=TablesSpec)
-    gcode: GcodeSpec = field(default_factory=GcodeSpec)
+    gcode: GcodeSpec = field(default_factory=lambda: GcodeSpec(name_of=path_of))  # notes name TOML paths
     groove: GrooveSpec = field(default_factory=GrooveSpec)
     conjugate: ConjugateSpec = field(default_factory=ConjugateSpec)
     linear: LinearSpec = field(default_factory=LinearSpec)  # a linear cam's bar ([linear])

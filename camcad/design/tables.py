@@ -12,6 +12,7 @@ import enum
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from camcad.design.paths import path_of
 from camcad.design.rules import (
     ANGLE_SUM_TOL_DEG,
     FULL_TURN_DEG,
@@ -176,6 +177,11 @@ def _follower_rule(key: FollowerKey) -> _Rule:
         KeyRange.SIGNED: _between(-MAX_LENGTH_MM, MAX_LENGTH_MM, unit),
     }[key.range]
     return _Rule("float", check=check, attr=key.attr)
+
+
+def _gcode_spec(**values: Any) -> GcodeSpec:
+    """The ``[gcode]`` table's spec, its program's notes naming its keys by their TOML paths."""
+    return GcodeSpec(**values, name_of=path_of)
 
 
 def _follower_spec(**values: Any) -> FollowerSpec:
@@ -408,7 +414,7 @@ _SPEC_CLASSES: dict[str, Callable[..., Any]] = {
     "dxf": DxfSpec,
     "mesh": MeshSpec,
     "tables": TablesSpec,
-    "gcode": GcodeSpec,
+    "gcode": _gcode_spec,
     "groove": GrooveSpec,
     "conjugate": ConjugateSpec,
     "linear": LinearSpec,

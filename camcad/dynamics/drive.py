@@ -52,6 +52,7 @@ from camcad.dynamics._cycle import cycle_mean, cycle_weights
 from camcad.errors import DesignError
 from camcad.extremes import Extreme
 from camcad.findings import Finding, Severity
+from camcad.knobs import Knob, TableKey
 from camcad.motion.segments import SegmentKind
 
 if TYPE_CHECKING:
@@ -138,16 +139,18 @@ class DriveSpec:
         ):
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and value > 0.0):
-                raise DesignError(f"drive.{name}", f"must be a positive number, got {value!r}")
+                raise DesignError(
+                    TableKey(Knob.DRIVE_TABLE, name), f"must be a positive number, got {value!r}"
+                )
         eff = self.gear_efficiency
         if not (math.isfinite(eff) and 0.0 < eff <= 1.0):
-            raise DesignError("drive.gear_efficiency", f"must be in (0, 1], got {eff!r}")
+            raise DesignError(Knob.GEAR_EFFICIENCY, f"must be in (0, 1], got {eff!r}")
         for name in ("camshaft_inertia_kg_m2", "axis_friction"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
-                raise DesignError(f"drive.{name}", f"must be ≥ 0, got {value!r}")
+                raise DesignError(TableKey(Knob.DRIVE_TABLE, name), f"must be ≥ 0, got {value!r}")
         if self.mode is DriveMode.CAMSHAFT and self.screw_lead_mm is not None:
-            raise DesignError("drive.screw_lead_mm", "applies to mode = 'servo-follower' only")
+            raise DesignError(Knob.SCREW_LEAD, "applies to mode = 'servo-follower' only")
 
     @property
     def transmission(self) -> float:
@@ -384,13 +387,13 @@ def analyse_drive(
 
 
 _CHECK_FIELDS = {
-    "peak torque": ("drive.motor_peak_torque_Nm", "a stronger motor or a larger gear ratio"),
+    "peak torque": (Knob.MOTOR_PEAK_TORQUE, "a stronger motor or a larger gear ratio"),
     "RMS torque": (
-        "drive.motor_rated_torque_Nm",
+        Knob.MOTOR_RATED_TORQUE,
         "a motor with a higher rated torque or a larger gear ratio",
     ),
-    "speed": ("drive.motor_max_rpm", "a faster motor or a smaller gear ratio"),
-    "inertia ratio": ("drive.max_inertia_ratio", "a motor with more rotor inertia or a larger gear ratio"),
+    "speed": (Knob.MOTOR_MAX_RPM, "a faster motor or a smaller gear ratio"),
+    "inertia ratio": (Knob.MAX_INERTIA_RATIO, "a motor with more rotor inertia or a larger gear ratio"),
 }
 
 

@@ -42,6 +42,7 @@ import numpy as np
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.errors import DesignError
 from camcad.findings import Finding, Severity
+from camcad.knobs import Knob, TableKey
 
 __all__ = [
     "FilmResult",
@@ -94,7 +95,10 @@ class LubricationSpec:
         ):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0.0):
-                raise DesignError(f"lubrication.{name}", f"must be a positive number [{unit}], got {value!r}")
+                raise DesignError(
+                    TableKey(Knob.LUBRICATION_TABLE, name),
+                    f"must be a positive number [{unit}], got {value!r}",
+                )
 
     @property
     def composite_roughness_um(self) -> float:
@@ -326,7 +330,7 @@ def film_findings(result: FilmResult) -> tuple[Finding, ...]:
         Finding(
             kind="film ratio",
             severity=Severity.SOFT,
-            field="lubrication.min_film_ratio",
+            field=Knob.MIN_FILM_RATIO,
             message=(
                 f"lubricant film ratio λ falls to {result.min_ratio:.3g} at "
                 f"{math.degrees(result.angle):.1f}°{flank} (h_min {result.min_thickness_um:.3g} µm), below "

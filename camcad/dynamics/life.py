@@ -38,6 +38,7 @@ from camcad.angles import TWO_PI
 from camcad.dynamics._cycle import cycle_weights
 from camcad.errors import DesignError
 from camcad.findings import Finding, Severity
+from camcad.knobs import Knob
 
 __all__ = [
     "BALL_EXPONENT",
@@ -102,9 +103,9 @@ class LoadStressLine:
 
     def __post_init__(self) -> None:
         """Check the constants: one-line errors naming the field."""
-        _positive("life.track_slope", self.slope, "1")
+        _positive(Knob.TRACK_SLOPE, self.slope, "1")
         if not math.isfinite(self.intercept):
-            raise DesignError("life.track_intercept", f"must be a finite number, got {self.intercept!r}")
+            raise DesignError(Knob.TRACK_INTERCEPT, f"must be a finite number, got {self.intercept!r}")
 
     def cycles(self, factor: ArrayLike) -> FloatArray:
         """Cycles to failure N at load-stress factors K [MPa]; ``inf`` where K ≤ 0 (unloaded)."""
@@ -147,17 +148,17 @@ class LifeSpec:
 
     def __post_init__(self) -> None:
         """Check every value: one-line errors naming the field."""
-        _positive("life.roller_dynamic_load_rating", self.roller_dynamic_load_rating, "N")
+        _positive(Knob.ROLLER_LOAD_RATING, self.roller_dynamic_load_rating, "N")
         p = self.roller_life_exponent
         if not (math.isclose(p, BALL_EXPONENT) or math.isclose(p, ROLLER_EXPONENT, rel_tol=1e-6)):
             raise DesignError(
-                "life.roller_life_exponent",
+                Knob.ROLLER_LIFE_EXPONENT,
                 f"must be 3 (ball bearing) or 10/3 (needle or roller bearing, ISO 281), got {p!r}",
             )
-        _positive("life.hours_per_day", self.hours_per_day, "h")
+        _positive(Knob.HOURS_PER_DAY, self.hours_per_day, "h")
         if self.hours_per_day is not None and self.hours_per_day > 24.0:
-            raise DesignError("life.hours_per_day", f"must be at most 24 h, got {self.hours_per_day!r}")
-        _positive("life.required_hours", self.required_hours, "h")
+            raise DesignError(Knob.HOURS_PER_DAY, f"must be at most 24 h, got {self.hours_per_day!r}")
+        _positive(Knob.REQUIRED_HOURS, self.required_hours, "h")
 
 
 def roller_turns_per_cam_turn(phi: ArrayLike, arc_speed: ArrayLike, *, roller_radius: float) -> float:
@@ -291,7 +292,7 @@ def roller_life(
     L10·10⁶ / (turns per cam turn · ω/2π) seconds.
     """
     if spec.roller_dynamic_load_rating is None:
-        raise DesignError("life.roller_dynamic_load_rating", "is needed for the roller's life")
+        raise DesignError(Knob.ROLLER_LOAD_RATING, "is needed for the roller's life")
     p = spec.roller_life_exponent
     dn = cycle_weights(phi) * np.abs(np.asarray(arc_speed, dtype=float))
     turns = roller_turns_per_cam_turn(phi, arc_speed, roller_radius=roller_radius)
@@ -402,7 +403,7 @@ def track_life(
     the largest K.
     """
     if spec.track is None:
-        raise DesignError("life.track_slope", "is needed for the track's life")
+        raise DesignError(Knob.TRACK_SLOPE, "is needed for the track's life")
     p = np.asarray(phi, dtype=float).ravel()
     k = load_stress_factor(force, curvature=curvature, length=length)
     i = int(np.argmax(k))
@@ -445,7 +446,7 @@ def life_findings(
             Finding(
                 kind="roller life",
                 severity=Severity.SOFT,
-                field="life.roller_dynamic_load_rating",
+                field=Knob.ROLLER_LOAD_RATING,
                 message=(
                     f"track roller L10 life {roller.hours:.4g} h (equivalent load "
                     f"{roller.equivalent_load:.4g} N, {roller.turns_per_cam_turn:.4g} roller turns a turn) "
@@ -462,7 +463,7 @@ def life_findings(
             Finding(
                 kind="track life",
                 severity=Severity.SOFT,
-                field="life.track_slope",
+                field=Knob.TRACK_SLOPE,
                 message=(
                     f"cam track surface-fatigue life {track.hours:.4g} h (load-stress factor "
                     f"{track.factor_max:.4g} MPa at {math.degrees(track.angle):.1f}°) is below the required "

@@ -27,6 +27,7 @@ from camcad.dynamics.spring import spring_from_spec
 from camcad.dynamics.tappet import GuidedTappet, tappet_forces
 from camcad.extremes import Extreme, Kind, Side, extremes_rows
 from camcad.findings import Finding, Severity
+from camcad.knobs import Knob
 from camcad.roots import brent_roots
 
 if TYPE_CHECKING:
@@ -572,7 +573,7 @@ def _findings(
             speeds=speeds,
             worst=force_min,
         )
-        field = "dynamics.spring_preload_torsional" if torsional else "dynamics.spring_preload"
+        field = Knob.SPRING_PRELOAD_TORSIONAL if torsional else Knob.SPRING_PRELOAD
         findings.append(_limit("jump", field, message, force_min, margin, "N"))
     if dyn.allowable_stress is not None and stress_max.value > dyn.allowable_stress:
         on = "" if stress_flank is None else f" on the {stress_flank} flank"
@@ -584,7 +585,7 @@ def _findings(
         findings.append(
             _limit(
                 "contact stress",
-                "dynamics.allowable_stress",
+                Knob.ALLOWABLE_STRESS,
                 message,
                 stress_max,
                 dyn.allowable_stress,
@@ -636,7 +637,7 @@ def _guide_notes(phi: FloatArray, sampled: _Pointwise, dyn: DynamicsSpec) -> lis
                 Finding(
                     kind="guide force side",
                     severity=Severity.NOTE,
-                    field="dynamics.model",
+                    field=Knob.DYNAMICS_MODEL,
                     message=message,
                     angle=arc[0],
                 )

@@ -239,6 +239,7 @@ def _compensated_files(
     design: Design, cam: Cam, act: ActualMotion, *, stock: float, tool_diameter: float
 ) -> tuple[str, Any, CompensatedCam, dict[str, Any]]:
     """The corrected program's text, the fit for its DXF, the corrected cam and the figures."""
+    from camcad.design.paths import path_of
     from camcad.fit import fit_cam_profile
     from camcad.geometry.families import family_of
     from camcad.toolpath import plan_toolpath
@@ -270,7 +271,10 @@ def _compensated_files(
 
     program = render_program(planned, spec.dialect)
     fit = fit_cam_profile(
-        corrected, tolerance=design.fit.tolerance, max_control_points=design.fit.max_control_points
+        corrected,
+        tolerance=design.fit.tolerance,
+        max_control_points=design.fit.max_control_points,
+        name_of=path_of,  # a FitError names fit.tolerance, as the build's does
     )
     figures = {
         "stock_mm": stock,

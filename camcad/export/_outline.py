@@ -68,7 +68,7 @@ def chord_budget(chord_tolerance: float, fit_error: float, *, field: str) -> flo
             field,
             f"{chord_tolerance:g} mm leaves no chord error for the polyline: the fitted spline is already "
             f"up to {fit_error:.6f} mm from the exact profile; allowed: a chord_tolerance of at least "
-            f"{fit_error + MIN_CHORD_BUDGET:.6f} mm, or a finer fit.tolerance",
+            f"{fit_error + MIN_CHORD_BUDGET:.6f} mm, or a finer fit tolerance",
         )
     return budget
 

@@ -104,6 +104,7 @@ from camcad.export.spec import DxfSpec
 from camcad.fit.curve import BSplineCurve
 from camcad.fit.result import ProfileFit
 from camcad.geometry.plate import BoreOutline, Plate, circle_segments
+from camcad.knobs import Knob
 from camcad.motion.segments import SegmentKind
 from camcad.toolpath.arcs.biarc import Pieces
 
@@ -543,7 +544,7 @@ def profile_poly_document(
     doc, msp = _new_document()
     tol = options.chord_tolerance
     outlines = [
-        flatten_bspline(c.fit.clamped, chord_budget(tol, c.fit.max_error, field="dxf.chord_tolerance"))
+        flatten_bspline(c.fit.clamped, chord_budget(tol, c.fit.max_error, field=Knob.DXF_CHORD_TOLERANCE))
         for c in _curves(fit, curves)
     ]
     for curve, outline in zip(_curves(fit, curves), outlines, strict=True):
@@ -712,7 +713,7 @@ def write_bar_dxfs(
     cam = part.cam
     outline = bar_outline(fit, bar)
     tol = options.chord_tolerance
-    poly = flatten_bspline(outline, chord_budget(tol, fit.max_error, field="dxf.chord_tolerance"))
+    poly = flatten_bspline(outline, chord_budget(tol, fit.max_error, field=Knob.DXF_CHORD_TOLERANCE))
     lo, hi = poly.min(axis=0), poly.max(axis=0)
 
     doc, msp = _new_document()

@@ -73,6 +73,7 @@ from camcad.export.atomic import atomic_write, atomic_write_bytes
 from camcad.export.spec import MeshSpec
 from camcad.fit.result import ProfileFit
 from camcad.geometry.plate import BoreOutline, Plate, circle_segments
+from camcad.knobs import Knob
 
 if TYPE_CHECKING:
     from camcad.geometry.cam import Cam
@@ -148,7 +149,7 @@ class SolidResult:
 
 def _cross_section(fit: ProfileFit, plate: Plate, tol: float) -> tuple[list[FloatArray], BoreOutline | None]:
     """The outline (chord error ``tol`` less the fit's error: ``tol`` from the exact profile) and bore."""
-    chord = chord_budget(tol, fit.max_error, field="mesh.chord_tolerance")
+    chord = chord_budget(tol, fit.max_error, field=Knob.MESH_CHORD_TOLERANCE)
     outline = oriented(np.asarray(flatten_bspline(fit.clamped, chord)), ccw=True)
     contours = [outline]
     bore = plate.bore
@@ -355,7 +356,7 @@ def build_groove_solid(
     blank_contours = [rim]
     if plate.bore is not None:
         blank_contours.append(oriented(np.asarray(plate.bore.polygon(tol)), ccw=False))
-    chords = [chord_budget(tol, f.max_error, field="mesh.chord_tolerance") for f in flanks]
+    chords = [chord_budget(tol, f.max_error, field=Knob.MESH_CHORD_TOLERANCE) for f in flanks]
     inner, outer = (
         oriented(np.asarray(flatten_bspline(f.clamped, c)), ccw=True)
         for f, c in zip(flanks, chords, strict=True)
@@ -534,7 +535,9 @@ def bar_solid(fit: ProfileFit, bar: Bar, plate: Plate, options: MeshSpec) -> Sol
     tol = options.chord_tolerance
     outline = bar_outline(fit, bar)
     polygon = oriented(
-        np.asarray(flatten_bspline(outline, chord_budget(tol, fit.max_error, field="mesh.chord_tolerance"))),
+        np.asarray(
+            flatten_bspline(outline, chord_budget(tol, fit.max_error, field=Knob.MESH_CHORD_TOLERANCE))
+        ),
         ccw=True,
     )
     readonly(polygon)

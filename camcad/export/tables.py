@@ -63,6 +63,7 @@ from camcad.export.records import write_csv, write_text
 from camcad.export.spec import TablesSpec
 from camcad.geometry.spec import Rotation
 from camcad.geometry.tool import check_tool
+from camcad.knobs import Knob
 
 if TYPE_CHECKING:
     from camcad.dynamics.results import DynamicsResult
@@ -156,10 +157,10 @@ def polar_radius(cam: Cam, theta: FloatArray, *, rotation: Rotation, distance: f
         bad = float(grid[int(np.argmax(np.diff(angle) <= 0.0))])
         curve, table = ("profile", "lift.csv") if distance == 0.0 else ("wheel-centre path", "polar.txt")
         raise NotStarShapedError(
-            f"cam.base_radius: the {curve} is not star-shaped about the cam axis near cam angle "
+            f"the {curve} is not star-shaped about the cam axis near cam angle "
             f"{math.degrees(bad):.2f}°: a ray meets it twice, so {table} has no polar radius; "
-            "use a larger cam.base_radius or a smaller follower.offset",
-            field="cam.base_radius",
+            "use a larger base radius or a smaller follower offset",
+            field=Knob.BASE_RADIUS,
         )
     start = angle[0]
     target = start + np.mod(theta - start, 2.0 * math.pi)  # in [θ_C(0), θ_C(0) + 2π)
@@ -276,12 +277,12 @@ def polar_table_text(cam: Cam, options: TablesSpec, *, name: str = "") -> str:
         check_tool(cam, radius)
     except GougeError as err:
         raise GougeError(
-            f"tables.wheel_radius: a wheel of radius {radius:g} mm cannot follow the profile: its "
+            f"a wheel of radius {radius:g} mm cannot follow the profile: its "
             f"smallest concave radius is {err.max_tool_radius:.4f} mm (near φ = "
             f"{math.degrees(err.phi_range[0]):.1f}°); allowed: wheel_radius ≤ {err.max_tool_radius:.4f} mm",
             phi_range=err.phi_range,
             max_tool_radius=err.max_tool_radius,
-            field="tables.wheel_radius",
+            field=Knob.WHEEL_RADIUS,
         ) from None
     step = options.step if options.polar_step is None else options.polar_step
     angle = table_angles(step)

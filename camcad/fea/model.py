@@ -67,6 +67,7 @@ from camcad.fea.spec import PLANE_STRAIN_RATIO, FeaSpec, PlaneModel
 from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.plate import BoreOutline, Plate
+from camcad.knobs import Knob
 
 __all__ = [
     "EDGE_NAMES",
@@ -116,7 +117,7 @@ def keyway_fillet(spec: FeaSpec, bore: BoreOutline) -> float:
     flank = bore.radius + bore.keyway_depth - bore.radius * math.cos(math.asin(half / bore.radius))
     if not 0.0 < radius < min(half, flank):
         raise DesignError(
-            "fea.keyway_fillet",
+            Knob.KEYWAY_FILLET,
             f"{radius:g} mm does not fit the keyway; allowed: > 0 and < {min(half, flank):.4g} mm "
             "(half the keyway width, and the flank's length beyond the bore)",
         )
@@ -316,7 +317,7 @@ def mesh_plate(cam: Cam, plate: Plate, cases: Sequence[LoadCase], spec: FeaSpec)
     bore = plate.bore
     if bore is None:
         raise DesignError(
-            "cam.bore", "the finite-element check holds the plate at its bore: give cam.bore > 0"
+            Knob.BORE, "the finite-element check holds the plate at its bore: give the cam a bore > 0"
         )
     fillet = keyway_fillet(spec, bore) if bore.has_keyway else 0.0
     outer_radius = float(np.max(np.hypot(*cam.profile(cam.sample_phi(math.radians(1.0))).point.T)))
@@ -326,7 +327,7 @@ def mesh_plate(cam: Cam, plate: Plate, cases: Sequence[LoadCase], spec: FeaSpec)
     area = 0.5 * abs(float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))) - math.pi * bore.radius**2
     if estimated_triangles(area, h_max) > MAX_ELEMENTS:
         raise DesignError(
-            "fea.mesh_size",
+            Knob.FEA_MESH_SIZE,
             f"{h_max:g} mm would fill the plate's {area:.0f} mm² with about "
             f"{estimated_triangles(area, h_max):.3g} triangles; allowed: at most {MAX_ELEMENTS} "
             f"(mesh_size ≥ {smallest_mesh_size(area):.3g} mm for this plate)",
@@ -484,7 +485,7 @@ def analyse_fea(
             Finding(
                 kind="von Mises stress",
                 severity=Severity.SOFT,
-                field="fea.allowable_stress",
+                field=Knob.FEA_ALLOWABLE_STRESS,
                 angle=worst.case.phi,
                 value=worst.peak.value,
                 limit=spec.allowable_stress,
@@ -499,7 +500,8 @@ def analyse_fea(
         )
     # an angle with no load case is worth knowing but breaks no limit
     findings += [
-        Finding(kind="FE load case", severity=Severity.NOTE, field="fea.angles", message=t) for t in skipped
+        Finding(kind="FE load case", severity=Severity.NOTE, field=Knob.FEA_ANGLES, message=t)
+        for t in skipped
     ]
     return FeaResult(
         nodes=model.nodes,

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from camcad.errors import FitError
+from camcad.knobs import Knob
 
 __all__ = ["Names", "SamplesTooFewError", "limit_error"]
 
@@ -25,9 +26,9 @@ class Names:
     sample limit is then reported against the tolerance.
     """
 
-    tolerance: str = "tolerance"
-    max_control_points: str = "max_control_points"
-    samples: str | None = "points"
+    tolerance: str | Knob = "tolerance"
+    max_control_points: str | Knob = "max_control_points"
+    samples: str | Knob | None = "points"
 
 
 class SamplesTooFewError(FitError):

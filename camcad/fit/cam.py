@@ -10,6 +10,7 @@ from camcad.fit._limits import Names, SamplesTooFewError
 from camcad.fit._profile import _fit_closed, fit_open_profile
 from camcad.fit.result import ProfileFit
 from camcad.geometry.cam import Cam
+from camcad.knobs import Knob, Namer
 
 __all__ = ["FIT_STEP", "fit_cam_profile"]
 
@@ -24,6 +25,7 @@ def fit_cam_profile(
     max_control_points: int | None = None,
     step: float | None = None,
     offset: float = 0.0,
+    name_of: Namer | None = None,
 ) -> ProfileFit:
     """Certified B-spline of ``cam.profile`` (or of its offset ``cam.offset_curve(φ, offset)``) over one turn.
 
@@ -59,6 +61,9 @@ def fit_cam_profile(
         profile itself (a groove's flanks,
         :func:`camcad.geometry.groove.groove_flanks`); the certificate is then
         against ``cam.offset_curve(φ, offset)``.
+    name_of
+        How the error names the fit's settings (the design layer: their TOML
+        paths); None: as :class:`~camcad.knobs.Knob` s.
 
     Raises
     ------
@@ -71,8 +76,10 @@ def fit_cam_profile(
         the fit does not use a step coarser than 0.1°.
     """
     names = Names(
-        tolerance="fit.tolerance",
-        max_control_points="fit.max_control_points",
+        tolerance=Knob.FIT_TOLERANCE if name_of is None else name_of(Knob.FIT_TOLERANCE),
+        max_control_points=(
+            Knob.FIT_MAX_CONTROL_POINTS if name_of is None else name_of(Knob.FIT_MAX_CONTROL_POINTS)
+        ),
         samples=None if step is None else "step",
     )
     h = min(cam.sample_step, FIT_STEP) if step is None else step

@@ -48,6 +48,7 @@ from camcad.fit.bspline import lsq_clamped, lsq_periodic, periodic_curve
 from camcad.fit.certify import CERT_SAFETY
 from camcad.fit.curve import BSplineCurve
 from camcad.geometry.barrel import BarrelFollower, BarrelOptions, WallSide, barrel_faces, face_rollers
+from camcad.knobs import Knob
 from camcad.motion.program import MotionProgram
 
 __all__ = [
@@ -390,11 +391,11 @@ def _fit_wall(
             break
     assert best is not None
     raise FitError(
-        f"fit.tolerance: the {side.name.lower()} wall's surface cannot meet {fit.tolerance:g} mm within "
+        f"the {side.name.lower()} wall's surface cannot meet {fit.tolerance:g} mm within "
         f"{fit.max_spans} knot spans (best {best[1].max_error:.4g} mm); loosen the tolerance",
         best_error=best[1].max_error,
         control_point_count=best[0].distinct_u * best[0].control_points.shape[1],
-        field="fit.tolerance",
+        field=Knob.FIT_TOLERANCE,
     )
 
 

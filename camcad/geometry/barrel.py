@@ -64,6 +64,7 @@ from camcad.errors import DesignError
 from camcad.geometry.envelope import PointElement
 from camcad.geometry.followers import arm_swing, turning_point
 from camcad.geometry.followers.base import slide_point
+from camcad.knobs import Knob
 from camcad.motion.program import Motion
 
 __all__ = [
@@ -597,49 +598,49 @@ def check_barrel(options: BarrelOptions, follower: BarrelFollower) -> None:
     if isinstance(follower, RibRoller):
         follower = follower.follower
     if o.kind is BarrelKind.RIB and not (math.isfinite(o.rib_width) and o.rib_width > 0.0):
-        raise DesignError("cam.rib_width", f"{o.rib_width!r} mm is not allowed; give a rib width > 0 mm")
+        raise DesignError(Knob.RIB_WIDTH, f"{o.rib_width!r} mm is not allowed; give a rib width > 0 mm")
     for path, value in (
-        ("cam.barrel_radius", o.barrel_radius),
-        ("cam.length", o.length),
-        ("groove.depth", o.depth),
-        ("follower.roller_radius", o.roller_radius),
-        ("follower.roller_length", o.roller_length),
+        (Knob.BARREL_RADIUS, o.barrel_radius),
+        (Knob.CAM_LENGTH, o.length),
+        (Knob.GROOVE_DEPTH, o.depth),
+        (Knob.ROLLER_RADIUS, o.roller_radius),
+        (Knob.ROLLER_LENGTH, o.roller_length),
     ):
         if not (math.isfinite(value) and value > 0.0):
             raise DesignError(path, f"{value!r} mm is not allowed; give a length > 0 mm")
     if not (math.isfinite(o.clearance) and o.clearance >= 0.0):
-        raise DesignError("groove.clearance", f"{o.clearance!r} mm is not allowed; give 0 mm or more")
+        raise DesignError(Knob.GROOVE_CLEARANCE, f"{o.clearance!r} mm is not allowed; give 0 mm or more")
     if not (math.isfinite(o.bore) and 0.0 <= o.bore < 2.0 * o.barrel_radius):
         raise DesignError(
-            "cam.bore",
+            Knob.BORE,
             f"{o.bore!r} mm is not allowed; give 0 ≤ bore < 2·barrel_radius = {2 * o.barrel_radius:g} mm",
         )
     wall = o.barrel_radius - 0.5 * o.bore
     if o.depth >= wall:
         raise DesignError(
-            "groove.depth",
+            Knob.GROOVE_DEPTH,
             f"{o.depth:g} mm reaches the bore: the barrel's wall is {wall:g} mm thick "
             f"(barrel_radius − bore/2); give depth < {wall:g} mm",
         )
     if o.roller_length >= o.depth:
         raise DesignError(
-            "follower.roller_length",
+            Knob.ROLLER_LENGTH,
             f"{o.roller_length:g} mm would touch the groove's bottom, {o.depth:g} mm deep; "
             f"give roller_length < {o.depth:g} mm or a deeper groove",
         )
     if isinstance(follower, OscillatingBarrelRoller):
         if o.roller is RollerShape.CONICAL:
             raise DesignError(
-                "follower.roller",
+                Knob.ROLLER,
                 '"conical" needs a radial roller axis (its apex on the barrel\'s axis); '
                 'on an arm use "cylindrical"',
             )
         d, arm = follower.pivot_distance, follower.arm_length
         if not (math.isfinite(d) and d >= 0.0):
-            raise DesignError("follower.pivot_distance", f"{d!r} mm is not allowed; give 0 mm or more")
+            raise DesignError(Knob.PIVOT_DISTANCE, f"{d!r} mm is not allowed; give 0 mm or more")
         if not (math.isfinite(arm) and arm > d):
             raise DesignError(
-                "follower.arm_length",
+                Knob.ARM_LENGTH,
                 f"{arm!r} mm cannot reach the barrel: the pivot is {d:g} mm from the barrel's axis; "
                 f"give arm_length > pivot_distance = {d:g} mm",
             )

@@ -42,6 +42,7 @@ from camcad.geometry.barrel import (
 )
 from camcad.geometry.curves import CurveSample, curve_sample
 from camcad.geometry.envelope import PointElement, offset_curve, translation_envelope
+from camcad.knobs import Knob
 from camcad.motion.program import Motion, MotionProgram
 
 __all__ = ["BarrelLimits", "DevelopedWalls", "barrel_limits", "developed_walls"]
@@ -256,13 +257,13 @@ def barrel_limits(
     thickness = dict(zip(("bottom", "top"), found[11:], strict=True)) if rib else {}
     if off.value >= bottom:
         raise DesignError(
-            "follower.pivot_distance",
+            Knob.PIVOT_DISTANCE,
             f"the arm swings the roller's axis {off.value:.3f} mm off the barrel's axis {off.where()}, "
             f"beyond the groove's bottom radius {bottom:g} mm; bring the pivot nearer or shorten the swing",
         )
     if advance.value <= 0.0:
         raise DesignError(
-            "follower.arm_length",
+            Knob.ARM_LENGTH,
             f"the groove crosses itself {advance.where()}: the arm moves the roller backwards along the "
             f"groove faster than the barrel turns it forward at the bottom ({advance.value:.3f} mm/rad); "
             "use a longer arm, a smaller swing or a larger barrel",
@@ -271,7 +272,7 @@ def barrel_limits(
         bad = z_low if z_low.value < 0.0 else z_high
         what = "rib" if rib else "groove"
         raise DesignError(
-            "follower.axial_position",
+            Knob.AXIAL_POSITION,
             f"the {what} reaches z = {bad.value:.3f} mm {bad.where()}, beyond the barrel's ends "
             f"0 … {options.length:g} mm; move axial_position or lengthen the barrel",
         )
@@ -280,9 +281,10 @@ def barrel_limits(
         Finding(
             kind="groove undercut",
             severity=Severity.HARD,
-            field="cam.barrel_radius",
+            field=Knob.BARREL_RADIUS,
+            field_first=True,
             message=(
-                f"cam.barrel_radius: the {what} {name} {'face' if rib else 'wall'} loops at the {where} "
+                f"the {what} {name} {'face' if rib else 'wall'} loops at the {where} "
                 f"(station {t:g} mm) {ext.where()}: the developed pitch line bends more sharply than the "
                 "roller; use a larger barrel, a smaller roller, a shallower groove or a gentler law"
             ),
@@ -301,9 +303,10 @@ def barrel_limits(
         Finding(
             kind="rib vanishes",
             severity=Severity.HARD,
-            field="cam.rib_width",
+            field=Knob.RIB_WIDTH,
+            field_first=True,
             message=(
-                f"cam.rib_width: the rib's faces cross at its {name} (station {t:g} mm) {ext.where()}, "
+                f"the rib's faces cross at its {name} (station {t:g} mm) {ext.where()}, "
                 f"where its least width is {ext.value:.3f} mm: a steep flank narrows the rib; "
                 "use a wider rib, a gentler law or a larger barrel"
             ),

@@ -32,6 +32,7 @@ from camcad.geometry.envelope import (
 from camcad.geometry.followers import Follower
 from camcad.geometry.followers.tied import TiedRoller
 from camcad.geometry.spec import ConjugateSpec, FollowerSpec, Rotation
+from camcad.knobs import Knob
 from camcad.motion.program import Motion, MotionProgram, Side
 from camcad.motion.segments import SegmentKind, SegmentSpec
 
@@ -280,7 +281,7 @@ class Cam:
     def _line_envelope(self, m: Motion, element: LineElement) -> tuple[CurveSample, FloatArray]:
         if self.stroke_length is not None:  # the design check refuses it (geometry.linear)
             raise DesignError(
-                "follower.type",
+                Knob.FOLLOWER_TYPE,
                 "a flat face has no envelope on a linear cam (it does not turn relative to it)",
             )
         return line_envelope(m.phi, element, self.sigma)

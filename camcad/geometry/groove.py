@@ -32,6 +32,7 @@ from camcad.extremes import Extreme, Kind, Side, extremes_rows
 from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.curves import CurveSample
+from camcad.knobs import Knob
 
 __all__ = ["GrooveAnalysis", "analyse_groove", "flank_offsets", "groove_flanks", "roller_flank_offsets"]
 
@@ -157,9 +158,10 @@ def analyse_groove(
             Finding(
                 kind="groove outside the blank",
                 severity=Severity.HARD,
-                field="cam.outer_radius",
+                field=Knob.OUTER_RADIUS,
+                field_first=True,
                 message=(
-                    f"cam.outer_radius: the groove's outer flank reaches {reach.value:.3f} mm from the cam "
+                    f"the groove's outer flank reaches {reach.value:.3f} mm from the cam "
                     f"axis {reach.where()}, beyond the blank's {outer_radius:g} mm; use outer_radius > "
                     f"{reach.value:.3f} mm (plus a wall)"
                 ),
@@ -174,9 +176,10 @@ def analyse_groove(
             Finding(
                 kind="groove into the bore",
                 severity=Severity.HARD,
-                field="cam.base_radius",
+                field=Knob.BASE_RADIUS,
+                field_first=True,
                 message=(
-                    f"cam.base_radius: the groove's inner flank comes within {near.value:.3f} mm of the cam "
+                    f"the groove's inner flank comes within {near.value:.3f} mm of the cam "
                     f"axis {near.where()}, into the bore (reaching {hole_radius:g} mm); enlarge the base "
                     "circle"
                 ),
@@ -195,9 +198,10 @@ def analyse_groove(
                 Finding(
                     kind="groove undercut",
                     severity=Severity.HARD,
-                    field="cam.base_radius",
+                    field=Knob.BASE_RADIUS,
+                    field_first=True,
                     message=(
-                        f"cam.base_radius: the groove's {flank} flank loops {ext.where()}: the pitch "
+                        f"the groove's {flank} flank loops {ext.where()}: the pitch "
                         f"curve's {what} radius is {ext.value + half:.3f} mm, not more than "
                         f"r_f + clearance/2 = {half:g} mm; enlarge the base circle or use a gentler law"
                     ),

@@ -18,6 +18,7 @@ from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import LineElement, PointElement
 from camcad.geometry.followers.tied import TiedRoller
 from camcad.geometry.sizing import curvature_finding, min_base_radius
+from camcad.knobs import Knob
 from camcad.roots import brent_root
 
 __all__ = [
@@ -148,7 +149,7 @@ def _pressure_finding(phi: FloatArray, alpha: FloatArray, worst: Extreme, limit:
     return Finding(
         kind="pressure angle",
         severity=Severity.SOFT,
-        field="cam.max_pressure_angle",
+        field=Knob.MAX_PRESSURE_ANGLE,
         message=(
             f"pressure angle reaches {math.degrees(worst.value):.2f}° > limit "
             f"{math.degrees(limit):g}° at {where}"
@@ -176,9 +177,10 @@ def _arm_face_check(
             Finding(
                 kind="face width",
                 severity=Severity.HARD,
-                field="follower.pivot_distance",
+                field=Knob.PIVOT_DISTANCE,
+                field_first=True,
                 message=(
-                    f"follower.pivot_distance: the contact comes within {reach_min.value:.3f} mm of the "
+                    f"the contact comes within {reach_min.value:.3f} mm of the "
                     f"pivot's foot on the face {reach_min.where()}, less than face_margin = "
                     f"{face_margin:g} mm; move the pivot further from the cam or lower the lift"
                 ),
@@ -193,9 +195,10 @@ def _arm_face_check(
             Finding(
                 kind="face width",
                 severity=Severity.HARD,
-                field="follower.face_width",
+                field=Knob.FACE_WIDTH,
+                field_first=True,
                 message=(
-                    f"follower.face_width: {face_width:g} mm does not cover the contact, which reaches "
+                    f"{face_width:g} mm does not cover the contact, which reaches "
                     f"{reach_max.value:.3f} mm along the face from the pivot's foot {reach_max.where()}; "
                     f"with face_margin {face_margin:g} mm use face_width ≥ {_up(needed):.2f} mm"
                 ),
@@ -218,15 +221,16 @@ def _face_check(
     if face_width is None or face_width >= needed:
         return needed, []
     message = (
-        f"follower.face_width: {face_width:g} mm does not cover the contact, which travels "
+        f"{face_width:g} mm does not cover the contact, which travels "
         f"{reach:.3f} mm off the follower axis {far.where()}; with face_margin "
         f"{face_margin:g} mm each side use face_width ≥ {_up(needed):.2f} mm"
     )
     found = Finding(
         kind="face width",
         severity=Severity.HARD,
-        field="follower.face_width",
+        field=Knob.FACE_WIDTH,
         message=message,
+        field_first=True,
         angle=far.phi,
         value=face_width,
         limit=needed,
@@ -361,8 +365,9 @@ def analyse_geometry(
     undercut_finding = Finding(
         kind="undercut" if cam.has_pitch_curve else "cusp",
         severity=Severity.HARD,
-        field="cam.base_radius" if cam.closed else "linear.stroke_length",
-        message=str(err),
+        field=Knob.BASE_RADIUS if cam.closed else Knob.STROKE_LENGTH,
+        message=err.message,
+        field_first=True,
         angle=undercut.worst_angle,
         value=undercut.worst,
         limit=limit,
@@ -392,9 +397,10 @@ def _pivot_clearance(cam: Cam, radius_max: Extreme) -> list[Finding]:
         Finding(
             kind="pivot clearance",
             severity=Severity.HARD,
-            field="follower.pivot_distance",
+            field=Knob.PIVOT_DISTANCE,
+            field_first=True,
             message=(
-                f"follower.pivot_distance: {d:g} mm puts the pivot inside the circle the profile sweeps "
+                f"{d:g} mm puts the pivot inside the circle the profile sweeps "
                 f"(the profile reaches {radius_max.value:.3f} mm from the cam axis {radius_max.where()}): "
                 f"the cam would hit the arm's hub; allowed: pivot_distance > {radius_max.value:.3f} mm "
                 "(move the pivot out, or lower the lift or the base radius)"
@@ -420,9 +426,10 @@ def _pivot_above_bar(cam: Cam, pivot: tuple[float, float]) -> list[Finding]:
         Finding(
             kind="pivot clearance",
             severity=Severity.HARD,
-            field="follower.pivot_distance",
+            field=Knob.PIVOT_DISTANCE,
+            field_first=True,
             message=(
-                f"follower.pivot_distance: the pivot at y = {pivot[1]:.3f} mm is not above the bar's edge, "
+                f"the pivot at y = {pivot[1]:.3f} mm is not above the bar's edge, "
                 f"which reaches y = {top.value:.3f} mm {top.where()}: the bar would hit the arm's hub; "
                 "move the pivot up, or lower the lift or the base line"
             ),
@@ -434,7 +441,7 @@ def _pivot_above_bar(cam: Cam, pivot: tuple[float, float]) -> list[Finding]:
     ]
 
 
-def conjugate_overlap(partner: Cam) -> tuple[str, str] | None:
+def conjugate_overlap(partner: Cam) -> tuple[Knob, str] | None:
     """Why a conjugate pair's two rollers overlap, as (field path, message); None when they clear.
 
     ``partner`` is the pair's second plate (:meth:`Cam.partner`). The second
@@ -475,7 +482,7 @@ def conjugate_overlap(partner: Cam) -> tuple[str, str] | None:
         lo = math.degrees(math.acos(min(1.0, cos_max)))
         allowed = f"{lo:.3f}° to {360.0 - lo:.3f}°"
     return (
-        "conjugate.angle",
+        Knob.CONJUGATE_ANGLE,
         f"{math.degrees(conj.angle):g}° puts the two rollers' centres {gap:.4g} mm apart at every cam "
         f"angle, less than the sum of their radii {need:g} mm: the rollers overlap ({how}); "
         f"allowed: {allowed}",
@@ -661,12 +668,18 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
     assert uc is not None
     if not cam.closed:  # a linear cam: the base line's height does not change the edge's curvature
         message = (
-            f"linear.stroke_length: undercut at {format_ranges(list(uc.ranges))}: the pitch line's convex "
+            f"undercut at {format_ranges(list(uc.ranges))}: the pitch line's convex "
             f"radius of curvature falls to {uc.worst:.3f} mm {uc.where()}, below the "
             f"{cam.follower.words.radius} {cam.roller_radius:g} mm, so the edge loops; lengthen the "
             f"stroke (now {cam.stroke_length:g} mm), {cam.follower.words.smaller} or use a gentler law"
         )
-        return UndercutError(message, phi_range=uc.ranges[0], worst=uc.worst, suggested_base_radius=None)
+        return UndercutError(
+            message,
+            phi_range=uc.ranges[0],
+            worst=uc.worst,
+            suggested_base_radius=None,
+            field=Knob.STROKE_LENGTH,
+        )
     sized = min_base_radius(cam, min_curvature_radius=min_curvature_radius)
     suggestion = math.ceil(sized.base_radius / _SUGGEST_ROUND_MM) * _SUGGEST_ROUND_MM
     where = format_ranges(list(uc.ranges))
@@ -685,14 +698,11 @@ def undercut_error(analysis: GeometryAnalysis, *, min_curvature_radius: float = 
             f"{uc.worst:.3f} mm {uc.where()}"
         )
         way_out = "or use a gentler motion law"
-    message = (
-        f"cam.base_radius: {what}; use base_radius ≥ {suggestion:.2f} mm "
-        f"(now {cam.base_radius:g} mm) {way_out}"
-    )
+    message = f"{what}; use base_radius ≥ {suggestion:.2f} mm (now {cam.base_radius:g} mm) {way_out}"
     return UndercutError(
         message,
         phi_range=uc.ranges[0],
         worst=uc.worst,
         suggested_base_radius=suggestion,
-        field="cam.base_radius",
+        field=Knob.BASE_RADIUS,
     )

@@ -42,6 +42,7 @@ from camcad.geometry.curves import CurveSample
 from camcad.geometry.envelope import PointElement, offset_curve, pressure_angle, translation_envelope
 from camcad.geometry.followers import FOLLOWER_TYPES
 from camcad.geometry.followers.base import Follower
+from camcad.knobs import Knob
 from camcad.motion.program import Motion, MotionProgram
 
 __all__ = ["LinearLimits", "LinearOptions", "LinearState", "linear_limits", "linear_state"]
@@ -79,11 +80,11 @@ class LinearState:
 def _roller(follower: Follower, options: LinearOptions) -> float:
     if not options.stroke_length > 0.0 or not math.isfinite(options.stroke_length):
         raise DesignError(
-            "cam.stroke_length", f"{options.stroke_length!r} mm is not allowed; give a length > 0 mm"
+            Knob.STROKE_LENGTH, f"{options.stroke_length!r} mm is not allowed; give a length > 0 mm"
         )
     if not follower.roller_radius > 0.0:
         raise DesignError(
-            "follower.type",
+            Knob.FOLLOWER_TYPE,
             "a flat face has no envelope on a linear cam (it does not turn relative to the plate); "
             f"use {' or '.join(t.word for t in FOLLOWER_TYPES.values() if t.two_sided)}",
         )
@@ -164,9 +165,10 @@ def linear_limits(
             Finding(
                 kind="undercut",
                 severity=Severity.HARD,
-                field="cam.stroke_length",
+                field=Knob.STROKE_LENGTH,
+                field_first=True,
                 message=(
-                    f"cam.stroke_length: the profile loops {convex.where()}: the pitch line's convex "
+                    f"the profile loops {convex.where()}: the pitch line's convex "
                     f"radius is {convex.value:.3f} mm, not more than the roller radius {r_f:g} mm; "
                     "lengthen the stroke, use a smaller roller or a gentler law"
                 ),

@@ -55,6 +55,7 @@ from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
 from camcad.geometry.envelope import LineElement, PointElement, to_cam
+from camcad.knobs import Knob, TableKey
 from camcad.motion.program import Side
 
 __all__ = [
@@ -222,7 +223,8 @@ class Sensitivity:
         if tol not in self.parameters:
             allowed = ", ".join(t.value for t in self.parameters)
             raise DesignError(
-                f"tolerance.{tol.value}", f"does not apply to this follower; allowed: {allowed}"
+                TableKey(Knob.TOLERANCE_TABLE, tol.value),
+                f"does not apply to this follower; allowed: {allowed}",
             )
         return self.parameters.index(tol)
 

@@ -24,6 +24,7 @@ from camcad.extremes import Extreme, Side, extremes_rows
 from camcad.findings import Finding, Severity
 from camcad.geometry.cam import Cam
 from camcad.geometry.spec import ConjugateSpec
+from camcad.knobs import Knob
 
 __all__ = [
     "SizingResult",
@@ -87,9 +88,10 @@ def curvature_finding(cam: Cam, worst: Extreme, *, required: float) -> Finding |
     return Finding(
         kind="curvature",
         severity=Severity.SOFT,
-        field="cam.min_curvature_radius",
+        field=Knob.MIN_CURVATURE_RADIUS,
+        field_first=True,
         message=(
-            f"cam.min_curvature_radius: the convex profile radius of curvature falls to {worst.value:.3f} mm "
+            f"the convex profile radius of curvature falls to {worst.value:.3f} mm "
             f"{worst.where()}, below the required {required:g} mm; {fix}, or lower the limit"
         ),
         angle=worst.phi,
@@ -193,7 +195,7 @@ def min_base_radius(
         hi *= 2.0
         if hi > _MAX_RADIUS_MM:
             raise DesignError(
-                "cam.max_pressure_angle",
+                Knob.MAX_PRESSURE_ANGLE,
                 f"no base radius up to {_MAX_RADIUS_MM:g} mm meets the limits "
                 f"(max pressure angle {math.degrees(max_pressure_angle):g}°, "
                 f"min curvature radius {min_curvature_radius:g} mm)",
@@ -261,7 +263,7 @@ def min_pivot_distance(
     See :func:`min_base_radius` for the limits and :func:`_arm_search` for the search.
     """
     if cam.follower.guide.pivot is None:
-        raise DesignError("follower.type", "sizing the pivot distance needs an oscillating follower")
+        raise DesignError(Knob.FOLLOWER_TYPE, "sizing the pivot distance needs an oscillating follower")
     phi = cam.sample_phi(step)
     return _arm_search(cam, phi, "pivot_distance", max_pressure_angle, min_curvature_radius, conjugate)
 
@@ -326,7 +328,7 @@ def _arm_search(
         previous = float(x)
     else:
         raise DesignError(
-            f"follower.{knob}" if knob == "pivot_distance" else "cam.max_pressure_angle",
+            Knob.PIVOT_DISTANCE if knob == "pivot_distance" else Knob.MAX_PRESSURE_ANGLE,
             f"no {knob} between {lo:.3f} and {hi:.3f} mm meets the limits (max pressure angle "
             f"{math.degrees(alpha_max):g}°, min curvature radius {rho_min:g} mm) at this "
             + ("pivot and arm" if knob == "base_radius" else "base radius"),

@@ -14,6 +14,7 @@ from camcad.angles import flagged_ranges, format_ranges
 from camcad.errors import GougeError
 from camcad.extremes import minimum
 from camcad.geometry.cam import Cam
+from camcad.knobs import Knob
 
 __all__ = ["check_tool"]
 
@@ -67,7 +68,8 @@ def check_tool(cam: Cam, tool_radius: float) -> float:
         f"tool Ø{2 * tool_radius:g} mm gouges the profile at φ = {format_ranges(ranges)}: "
         f"its concave radius is down to {smallest:.3f} mm, below the tool radius "
         f"{tool_radius:g} mm; the largest tool that fits is Ø{2 * smallest:.3f} mm "
-        "(set gcode.tool_diameter below it)",
+        "(set the tool diameter below it)",
         phi_range=ranges[0],
         max_tool_radius=smallest,
+        field=Knob.TOOL_DIAMETER,
     )

@@ -44,6 +44,7 @@ from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
 from camcad.geometry.made import MadeMotion, made_motion
 from camcad.geometry.sensitivity import Tol, applicable, mount_of, sensitivities
+from camcad.knobs import Knob, TableKey
 from camcad.motion.segments import SegmentKind
 
 if TYPE_CHECKING:
@@ -109,7 +110,7 @@ def _largest(cam: Cam, tol: Tol) -> tuple[float, str]:
 def _check(cam: Cam, tolerances: Sequence[Tolerance]) -> None:
     allowed = applicable(mount_of(cam))
     for t in tolerances:
-        field = f"tolerance.{t.tol.value}"
+        field = TableKey(Knob.TOLERANCE_TABLE, t.tol.value)
         if t.tol not in allowed:
             names = ", ".join(a.value for a in allowed)
             raise DesignError(field, f"does not apply to this follower; allowed: {names}")
@@ -205,7 +206,7 @@ def monte_carlo(
     """
     _check(cam, tolerances)
     if samples < 2:
-        raise DesignError("tolerance.samples", f"{samples}; allowed: at least 2")
+        raise DesignError(Knob.TOLERANCE_SAMPLES, f"{samples}; allowed: at least 2")
     deltas = _draw(tolerances, samples, seed)
     dwell = dwell_angles(cam)
     phi = _grid(cam, dwell, step, peaks)
@@ -471,9 +472,9 @@ def allocate(
     K the quantities that move the dwell, taken at the dwell that binds each one.
     """
     if not (math.isfinite(required) and required > 0.0):
-        raise DesignError("tolerance.dwell_accuracy", f"{required!r}; allowed: > 0")
+        raise DesignError(Knob.DWELL_ACCURACY, f"{required!r}; allowed: > 0")
     if not 0.0 < confidence < 1.0:
-        raise DesignError("tolerance.confidence", f"{confidence!r}; allowed: between 0 and 1")
+        raise DesignError(Knob.CONFIDENCE, f"{confidence!r}; allowed: between 0 and 1")
     coef = np.abs(np.atleast_2d(np.asarray(coefficients, dtype=float)))
     coef = np.where(coef < 1e-12 * max(float(np.max(coef)), 1e-300), 0.0, coef)
     if method is Method.WORST_CASE:
@@ -488,7 +489,7 @@ def allocate(
     else:
         w = np.array([weights.get(p, 0.0) for p in parameters])
         if np.any(~np.isfinite(w)) or np.any(w < 0.0) or not np.any(w > 0.0):
-            raise DesignError("tolerance.weights", "allowed: finite weights ≥ 0, at least one > 0")
+            raise DesignError(Knob.TOLERANCE_WEIGHTS, "allowed: finite weights ≥ 0, at least one > 0")
         if method is Method.WORST_CASE:
             spread = np.sum(coef * w, axis=1)
         else:

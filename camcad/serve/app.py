@@ -71,6 +71,7 @@ from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
 from camcad.design import load_design, parse_design
+from camcad.design.paths import named_error
 from camcad.errors import CamcadError, DesignError, UsageError
 from camcad.export.records import json_safe
 from camcad.serve.form import design_data, form_fields, form_groups
@@ -331,7 +332,7 @@ class Designer:
         try:
             data = self.data(values)
         except DesignError as err:
-            return {"ok": False, "errors": [{"field": err.field, "message": err.message}]}
+            return {"ok": False, "errors": [{"field": named_error(err).field, "message": err.message}]}
         return evaluate(data, source=str(self.path))
 
     def save(self, values: Mapping[str, Any], revision: str = "") -> dict[str, Any]:
@@ -352,7 +353,7 @@ class Designer:
             return {
                 "saved": None,
                 "conflict": False,
-                "errors": [{"field": err.field, "message": err.message}],
+                "errors": [{"field": named_error(err).field, "message": err.message}],
             }
         with self.lock:
             if self.loaded is not loaded:  # loaded anew while this request was validated: the form is old
@@ -691,7 +692,7 @@ class _Handler(BaseHTTPRequestHandler):
             try:
                 data = self.server.run(designer.build_zip, values)
             except CamcadError as err:  # bad input or a hard limit: the field as data, the message without it
-                errors = [{"field": err.field, "message": err.message}]
+                errors = [{"field": named_error(err).field, "message": err.message}]
                 self._json(HTTPStatus.UNPROCESSABLE_ENTITY, {"ok": False, "errors": errors})
                 return
             name = f"{designer.path.stem}-shop-files.zip"

@@ -34,6 +34,7 @@ from camcad._plots.design import (
     follower_drawings,
 )
 from camcad.design import parse_design
+from camcad.design.paths import named_error
 from camcad.errors import CamcadError
 from camcad.export.records import json_safe
 from camcad.pipeline import analyse
@@ -266,7 +267,7 @@ def evaluate(data: Mapping[str, Any], *, source: str = "") -> dict[str, Any]:
         design = parse_design(data, source=source)
         analysis = analyse(design, fit=False, toolpath=False, strict=False)
     except CamcadError as err:  # bad input, or a limit the analysis cannot get past even when not strict
-        return {"ok": False, "errors": [{"field": err.field, "message": err.message}]}
+        return {"ok": False, "errors": [{"field": named_error(err).field, "message": err.message}]}
     summary = analysis.summary()
     return {
         "ok": True,

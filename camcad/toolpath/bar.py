@@ -27,6 +27,7 @@ from camcad.angles import TWO_PI
 from camcad.geometry.cam import Cam
 from camcad.geometry.families import Bar
 from camcad.geometry.tool import check_tool
+from camcad.knobs import Knob
 from camcad.toolpath.passes import Program
 from camcad.toolpath.plan import Toolpath
 from camcad.toolpath.spec import Direction, GcodeSpec
@@ -164,6 +165,6 @@ def plan_bar(cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float
         notes=(
             f"linear cam bar: open edge cut from X{bar.x0:.4f} to X{x1:.4f}, bottom at Y{bar.bottom:.4f}; "
             "the blank is squared beforehand",
-            *(["no tabs on a bar edge (gcode.tab_count ignored)"] if spec.tab_count else []),
+            *([f"no tabs on a bar edge ({spec.name_of(Knob.TAB_COUNT)} ignored)"] if spec.tab_count else []),
         ),
     )

@@ -68,6 +68,7 @@ from camcad._typing import FloatArray, readonly
 from camcad.errors import DesignError
 from camcad.geometry.barrel import BarrelFollower, BarrelKind, BarrelOptions, RollerShape
 from camcad.geometry.barrel_limits import developed_walls
+from camcad.knobs import Knob
 from camcad.motion.program import MotionProgram
 
 __all__ = [
@@ -184,7 +185,7 @@ def _refined(
         if not bad.any():
             return phi, float(gap.max())
         phi = np.union1d(phi, mid[bad, 3])
-    raise DesignError("gcode.tolerance", f"{tolerance:g} mm cannot be met by splitting blocks; loosen it")
+    raise DesignError(Knob.GCODE_TOLERANCE, f"{tolerance:g} mm cannot be met by splitting blocks; loosen it")
 
 
 def _pass(
@@ -223,21 +224,21 @@ def plan_barrel(
         rib (module notes).
     """
     for path, value in (
-        ("gcode.tolerance", spec.tolerance),
-        ("gcode.step_down", spec.step_down),
-        ("gcode.stepover", spec.stepover),
-        ("gcode.rough_diameter", spec.rough_diameter),
+        (Knob.GCODE_TOLERANCE, spec.tolerance),
+        (Knob.STEP_DOWN, spec.step_down),
+        (Knob.STEPOVER, spec.stepover),
+        (Knob.ROUGH_DIAMETER, spec.rough_diameter),
     ):
         if not (math.isfinite(value) and value > 0.0):
             raise DesignError(path, f"{value!r} is not allowed; give a number > 0")
     if options.kind is BarrelKind.RIB:
         raise DesignError(
-            "cam.style",
+            Knob.CAM_STYLE,
             '"barrel-rib": the 4-axis program machines a groove; a rib\'s barrel is not planned yet',
         )
     cone = options.roller is RollerShape.CONICAL
     if not (math.isfinite(spec.stock) and spec.stock >= 0.0):
-        raise DesignError("gcode.stock", f"{spec.stock!r} mm is not allowed; give 0 mm or more")
+        raise DesignError(Knob.STOCK, f"{spec.stock!r} mm is not allowed; give 0 mm or more")
     # a cone: rough as for the cylinder of its wall's radius at the bottom (module notes)
     r_w = (
         float(options.roller_at(options.bottom_radius, clearance=True))
@@ -248,7 +249,7 @@ def plan_barrel(
     reach = r_w - r_c - spec.stock
     if reach < 0.0:
         raise DesignError(
-            "gcode.rough_diameter",
+            Knob.ROUGH_DIAMETER,
             f"{spec.rough_diameter:g} mm does not fit the groove {2 * r_w:g} mm wide with {spec.stock:g} mm "
             f"stock on each wall; give rough_diameter ≤ {2 * (r_w - spec.stock):g} mm",
         )

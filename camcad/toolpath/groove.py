@@ -53,6 +53,7 @@ from dataclasses import replace
 from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
 from camcad.geometry.groove import GrooveAnalysis, analyse_groove
+from camcad.knobs import Knob
 from camcad.toolpath.contour import Contour, Step, fit_contour, offset_contour, round_mm
 from camcad.toolpath.moves import Move, move_length
 from camcad.toolpath.passes import Program, check_bore, mill_bore
@@ -94,7 +95,7 @@ def default_groove_tool(groove: GrooveAnalysis) -> float:
     fits = [d for d in STANDARD_END_MILLS if d <= limit]
     if not fits:
         raise DesignError(
-            "gcode.tool_diameter",
+            Knob.TOOL_DIAMETER,
             f"no standard end mill fits the groove ({groove.width:.4f} mm wide, largest cutter "
             f"D{2.0 * groove.tool_radius_max:.3f} mm); allowed: state a tool diameter below {limit:.4f} mm",
         )
@@ -137,21 +138,21 @@ def check_groove_tool(groove: GrooveAnalysis, tool_radius: float) -> None:
     smallest = 2.0 * half / (MAX_CLEARING_PASSES + 1)
     if tool_radius >= half:
         raise DesignError(
-            "gcode.tool_diameter",
+            Knob.TOOL_DIAMETER,
             f"the tool D{d:g} mm is not narrower than the groove ({groove.width:.4f} mm wide); "
             f"allowed: a tool diameter below {groove.width:.4f} mm",
         )
     if tool_radius > groove.tool_radius_max:
         at = groove.tool_radius_at
         raise DesignError(
-            "gcode.tool_diameter",
+            Knob.TOOL_DIAMETER,
             f"the tool D{d:g} mm is larger than the flanks' smallest concave radius "
             f"{at.value:.3f} mm {at.where()}, so it would gouge that flank; allowed: a tool diameter "
             f"of at most {2.0 * groove.tool_radius_max:.3f} mm",
         )
     if (half - tool_radius) / tool_radius > MAX_CLEARING_PASSES:
         raise DesignError(
-            "gcode.tool_diameter",
+            Knob.TOOL_DIAMETER,
             f"the tool D{d:g} mm would need more than {MAX_CLEARING_PASSES} clearing passes on each side "
             f"of the groove ({groove.width:.4f} mm wide); allowed: a tool diameter above {smallest:.4f} mm",
         )
@@ -243,12 +244,13 @@ def plan_groove(
     """
     if spec.machine is not Machine.XY:
         raise DesignError(
-            "gcode.machine",
+            Knob.MACHINE,
             f"{spec.machine.value!r}: a groove is milled on an XY machine; allowed: 'xy'",
         )
     if not 0.0 < depth < thickness:
         raise DesignError(
-            "groove.depth", f"{depth:g} mm must be above 0 and below the blank's thickness {thickness:g} mm"
+            Knob.GROOVE_DEPTH,
+            f"{depth:g} mm must be above 0 and below the blank's thickness {thickness:g} mm",
         )
     fit_tol = _fit_tolerance(spec.tolerance)
     _check_corners(cam)
@@ -288,7 +290,8 @@ def plan_groove(
     if chosen:
         notes.insert(
             0,
-            f"tool D{spec.tool_diameter:g} chosen by camcad (no gcode.tool_diameter given): the largest "
+            f"tool D{spec.tool_diameter:g} chosen by camcad (no {spec.name_of(Knob.TOOL_DIAMETER)} given): "
+            "the largest "
             f"standard end mill at most {DEFAULT_TOOL_SHARE:g} x the groove width and within the flanks' "
             f"largest cutter D{2.0 * groove.tool_radius_max:.3f}",
         )
@@ -318,7 +321,7 @@ def plan_groove(
         mill_bore(prog, spec, bore, thickness + spec.breakthrough)
         prog.rapid(z=spec.clearance_height)
     elif bore > 0.0:
-        notes.append(f"bore D{bore:g} not milled (gcode.mill_bore = false)")
+        notes.append(f"bore D{bore:g} not milled ({spec.name_of(Knob.MILL_BORE)} = false)")
     prog.comment(f"slot along the centre line: ramp {len(levels)} laps to Z{bottom:.4f}")
     prog.rapid(*centre.start)
     prog.rapid(z=spec.safe_height)

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 from camcad.errors import DesignError
 from camcad.geometry.families import Barrel, Part
+from camcad.knobs import Knob
 from camcad.toolpath.bar import plan_bar
 from camcad.toolpath.groove import plan_groove
 from camcad.toolpath.plan import Toolpath, plan_toolpath
@@ -53,7 +54,7 @@ def barrel_toolpath_options(barrel: Barrel, spec: GcodeSpec) -> BarrelToolpathOp
         rough = spec.tool_diameter
     if rough > room:
         raise DesignError(
-            "gcode.tool_diameter",
+            Knob.TOOL_DIAMETER,
             f"{rough:g} mm does not fit the groove {2 * o.roller_radius + o.clearance:g} mm wide with "
             f"{spec.stock_to_leave:g} mm stock on each wall; allowed: ≤ {room:g} mm",
         )

@@ -11,6 +11,7 @@ import math
 from typing import Any
 
 from camcad.errors import DesignError
+from camcad.knobs import Knob
 from camcad.toolpath.contour import Contour, round_mm, round_point
 from camcad.toolpath.moves import Move, MoveKind
 from camcad.toolpath.spec import Direction, GcodeSpec
@@ -138,10 +139,10 @@ def check_bore(spec: GcodeSpec, bore: float) -> None:
         When there is no bore, or it is not larger than the tool.
     """
     if bore <= 0.0:
-        raise DesignError("gcode.mill_bore", "the cam has no bore (cam.bore = 0); set mill_bore = false")
+        raise DesignError(Knob.MILL_BORE, "the cam has no bore (bore = 0); set mill_bore = false")
     if bore <= spec.tool_diameter:
         raise DesignError(
-            "gcode.mill_bore",
+            Knob.MILL_BORE,
             f"the bore Ø{bore:g} mm is not larger than the tool Ø{spec.tool_diameter:g} mm, "
             "so it cannot be helix-milled; use a smaller tool or drill the bore",
         )

@@ -29,6 +29,7 @@ from camcad._typing import FloatArray
 from camcad.errors import DesignError, DesignLimitError
 from camcad.geometry.cam import Cam
 from camcad.geometry.tool import check_tool
+from camcad.knobs import Knob
 from camcad.toolpath.arcs.biarc import norm2
 from camcad.toolpath.contour import LINE_SAGITTA, Contour, fit_contour, offset_contour, round_mm
 from camcad.toolpath.moves import Move, MoveKind, path_length
@@ -135,7 +136,7 @@ def _fit_tolerance(tol: float) -> float:
     fit = min(0.8 * tol, (1.0 - LINE_SAGITTA) * tol - _ROUNDING_ALLOWANCE)
     if fit < 0.25 * tol:
         raise DesignError(
-            "gcode.tolerance",
+            Knob.GCODE_TOLERANCE,
             f"{tol:g} mm is finer than 4-decimal output can hold; use at least 0.0005 mm",
         )
     return fit
@@ -164,13 +165,11 @@ def _tab_windows(cam: Cam, spec: GcodeSpec, phi0: float) -> list[tuple[float, fl
         room += f"do not fit around the {total:.1f} mm contour"
         if most >= 1:
             raise DesignError(
-                "gcode.tab_count",
+                Knob.TAB_COUNT,
                 f"{room}; allowed: at most {most} tab(s) of this width"
                 + (f", or tabs narrower than {widest:.2f} mm" if widest > 0 else ""),
             )
-        raise DesignError(
-            "gcode.tab_width", f"{room}: not even one fits; use narrower tabs or a smaller tool"
-        )
+        raise DesignError(Knob.TAB_WIDTH, f"{room}: not even one fits; use narrower tabs or a smaller tool")
     out = []
     for i in range(spec.tab_count):
         mid = (i + 0.5) * spacing
@@ -199,7 +198,7 @@ def _lead_radius(
             return radius
         radius /= 1.25
     raise DesignError(
-        "gcode.start_angle",
+        Knob.START_ANGLE,
         f"no room for a lead of {0.1 * wanted:g} mm or more at φ = {math.degrees(phi0):g}°; "
         "choose another start_angle (a dwell is best)",
     )
@@ -288,7 +287,7 @@ def plan_toolpath(
         mill_bore(prog, spec, bore, depth)
         prog.rapid(z=spec.clearance_height)
     elif bore > 0.0:
-        notes.append(f"bore D{bore:g} not milled (gcode.mill_bore = false)")
+        notes.append(f"bore D{bore:g} not milled ({spec.name_of(Knob.MILL_BORE)} = false)")
     r = spec.tool_radius
     for k, z in enumerate(levels, start=1):
         cut_contour(
@@ -329,7 +328,7 @@ def _tab_top(spec: GcodeSpec, thickness: float) -> float | None:
         return None
     if spec.tab_height >= thickness:
         raise DesignError(
-            "gcode.tab_height",
+            Knob.TAB_HEIGHT,
             f"{spec.tab_height:g} mm must be below the plate thickness {thickness:g} mm",
         )
     return round_mm(-thickness + spec.tab_height)

@@ -45,6 +45,7 @@ from camcad.extremes import maximum
 from camcad.geometry.cam import Cam
 from camcad.geometry.spec import Rotation
 from camcad.geometry.tool import check_tool
+from camcad.knobs import Knob
 from camcad.motion.program import Side
 from camcad.toolpath.spec import Cutter, Direction, GcodeSpec, Machine
 
@@ -163,13 +164,13 @@ def _check_cutter(cam: Cam, spec: GcodeSpec) -> float:
             raise
         largest = err.max_tool_radius
         raise GougeError(
-            f"gcode.tool_diameter: a wheel of radius {spec.tool_radius:g} mm grinds the profile exactly "
+            f"a wheel of radius {spec.tool_radius:g} mm grinds the profile exactly "
             f"only where every concave radius is at least its radius, but the smallest concave radius "
             f"is {largest:.4f} mm (near φ = {math.degrees(err.phi_range[0]):.1f}°); the largest wheel "
-            f"is Ø{2.0 * largest:.4f} mm (set gcode.tool_diameter to at most that)",
+            f"is Ø{2.0 * largest:.4f} mm (set the tool diameter to at most that)",
             phi_range=err.phi_range,
             max_tool_radius=largest,
-            field="gcode.tool_diameter",
+            field=Knob.TOOL_DIAMETER,
         ) from None
 
 
@@ -217,11 +218,11 @@ def _path(cam: Cam, spec: GcodeSpec) -> _Path:
     if np.any(steps <= 0.0):
         bad = float(np.mod(phi0 + sense * u[int(np.argmax(steps <= 0.0))], 2.0 * math.pi))
         raise NotStarShapedError(
-            f"gcode.machine: the tool-centre path is not star-shaped about the cam axis near cam angle "
+            f"the tool-centre path is not star-shaped about the cam axis near cam angle "
             f"{math.degrees(bad):.2f}°: a ray from the axis meets it twice, so a tool on a line through "
             "the axis would have to turn the cam back; use machine = 'xy', a smaller tool, or a larger "
-            "cam.base_radius",
-            field="gcode.machine",
+            "base radius",
+            field=Knob.MACHINE,
         )
     # shift whole turns so that the first rotary word lies in [0°, 360°)
     sign = 1.0 if spec.rotary_direction is Rotation.CCW else -1.0
@@ -350,7 +351,7 @@ def plan_rotary(cam: Cam, spec: GcodeSpec, *, name: str, thickness: float) -> Ro
         When ``spec.machine`` is not rotary.
     """
     if spec.machine is not Machine.ROTARY:
-        raise DesignError("gcode.machine", f"{spec.machine.value!r}: plan_rotary plans machine = 'rotary'")
+        raise DesignError(Knob.MACHINE, f"{spec.machine.value!r}: plan_rotary plans machine = 'rotary'")
     concave = _check_cutter(cam, spec)
     path = _path(cam, spec)
     arc = _arc_lengths(cam, path)
@@ -370,7 +371,7 @@ def plan_rotary(cam: Cam, spec: GcodeSpec, *, name: str, thickness: float) -> Ro
         x = np.insert(x, k + 1, np.round(path.radius[mid], X_DECIMALS))
         deviation, where = _certify(cam, spec, path, ends, x)
     if deviation > spec.tolerance:  # pragma: no cover - a block of one sample step is far within
-        raise DesignError("gcode.tolerance", f"{spec.tolerance:g} mm cannot be certified on a rotary path")
+        raise DesignError(Knob.GCODE_TOLERANCE, f"{spec.tolerance:g} mm cannot be certified on a rotary path")
     _, turn = _words(path, ends)
     length = np.diff(arc[np.asarray(ends)])
     readonly(length)

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from camcad.geometry.spec import Rotation
+from camcad.knobs import Namer
 
 __all__ = ["Cutter", "Dialect", "Direction", "GcodeSpec", "Machine", "RotaryAxis"]
 
@@ -78,6 +79,8 @@ class GcodeSpec:
     rotary_axis: RotaryAxis = RotaryAxis.A
     rotary_direction: Rotation = Rotation.CCW  # how the cam turns, seen from +Z, as the rotary word grows
     cutter: Cutter = Cutter.END_MILL  # rotary machine only
+    name_of: Namer = field(default=str, compare=False, repr=False)
+    """How the program's notes name a setting (the design layer gives its TOML path; default: words)."""
 
     @property
     def tool_radius(self) -> float:

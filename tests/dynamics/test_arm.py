@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from camcad.design import Design, parse_design
+from camcad.design.paths import path_of
 from camcad.dynamics import STANDARD_GRAVITY, analyse_dynamics
 from camcad.geometry.cam import Cam
 from camcad.geometry.envelope import to_cam
@@ -120,7 +121,7 @@ def test_the_preload_advice_is_the_true_limit() -> None:
     _, _, result = run(fast)
     assert result.jump
     assert result.preload_unit == "N·mm"
-    assert any(f.field == "dynamics.spring_preload_torsional" for f in result.findings)
+    assert any(path_of(f.field) == "dynamics.spring_preload_torsional" for f in result.findings)
     need = result.min_preload
     for preload, jumps in ((need * 1.001, False), (need * 0.99, True)):
         trial = parse_design(

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.integrate import quad
 
+from camcad.design.paths import path_of
 from camcad.dynamics.drive import (
     DriveMode,
     DriveSpec,
@@ -159,7 +160,7 @@ def test_checks_pass_and_fail_per_line():
         lines["inertia ratio"].value == pytest.approx(0.05 / 4.0 / 1e-3)
         and lines["inertia ratio"].ok is False
     )
-    assert {f.field for f in r.findings} == {
+    assert {path_of(f.field) for f in r.findings} == {
         "drive.motor_peak_torque_Nm",
         "drive.motor_max_rpm",
         "drive.max_inertia_ratio",
@@ -221,4 +222,4 @@ def test_segment_characteristics_skip_dwells():
 def test_bad_drive_input_names_the_field(field, kwargs):
     with pytest.raises(DesignError) as err:
         DriveSpec(**kwargs)
-    assert err.value.path == field
+    assert path_of(err.value.path) == field

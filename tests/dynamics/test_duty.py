@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose
 
 from camcad import pipeline
 from camcad.design import load_design, parse_design
+from camcad.design.paths import path_of
 from camcad.errors import DesignError
 
 SAMPLE = Path(__file__).resolve().parents[2] / "samples" / "indexing_drive.toml"
@@ -76,7 +77,7 @@ def test_motor_torque_is_the_exact_input_torque_through_a_unit_gearbox():
 def test_film_ratio_below_the_limit_is_a_soft_finding():
     analysis = _analyse(_data(lubrication={**OIL, "min_film_ratio": 50.0}))
     (finding,) = [f for f in analysis.findings if f.kind == "film ratio"]
-    assert not finding.hard and finding.field == "lubrication.min_film_ratio"
+    assert not finding.hard and path_of(finding.field) == "lubrication.min_film_ratio"
     assert finding.value == pytest.approx(analysis.summary()["lubrication"]["min_film_ratio"])
     assert "film ratio" in analysis.violations
 
@@ -160,7 +161,7 @@ def test_oscillating_roller_runs_every_table():
 def test_bad_tables_name_the_field(tables, path):
     with pytest.raises(DesignError) as err:
         parse_design(_data(**tables))
-    assert err.value.path == path
+    assert path_of(err.value.path) == path
     assert "\n" not in str(err.value)
 
 

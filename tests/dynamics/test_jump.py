@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from camcad.design import Design, parse_design
+from camcad.design.paths import path_of
 from camcad.dynamics import analyse_dynamics, covering_arc, loss_runs, speed_limits
 from camcad.geometry.cam import Cam
 
@@ -96,7 +97,7 @@ def test_jump_is_reported_with_its_remedies():
     assert f"raise the preload to ≥ {preload:.1f} N" in warning
     assert f"keep the speed ≤ {speed:.1f} rpm" in warning
     (jump,) = [f for f in result.findings if f.kind == "jump"]  # a soft limit, naming the knob
-    assert not jump.hard and jump.field == "dynamics.spring_preload" and jump.message == warning
+    assert not jump.hard and path_of(jump.field) == "dynamics.spring_preload" and jump.message == warning
 
 
 def test_no_jump_for_an_unloaded_follower():

@@ -22,6 +22,7 @@ import pytest
 import trimesh
 
 from camcad.design import load_design
+from camcad.design.paths import path_of
 from camcad.errors import DesignError
 from camcad.export._outline import chord_budget
 from camcad.pipeline import build
@@ -129,4 +130,4 @@ def test_a_chord_tolerance_the_fit_already_uses_is_refused_naming_the_field():
     assert chord_budget(0.005, 0.001, field="dxf.chord_tolerance") == pytest.approx(0.004)
     with pytest.raises(DesignError) as err:
         chord_budget(0.001, 0.00095, field="mesh.chord_tolerance")
-    assert err.value.path == "mesh.chord_tolerance" and "at least 0.001050" in err.value.message
+    assert path_of(err.value.path) == "mesh.chord_tolerance" and "at least 0.001050" in err.value.message

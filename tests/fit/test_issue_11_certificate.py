@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 
 import camcad
 from camcad.design import parse_design
+from camcad.design.paths import path_of
 from camcad.errors import FitError
 from camcad.fit import fit_cam_profile, fit_profile
 from camcad.fit.bspline import lsq_periodic
@@ -202,7 +203,7 @@ def test_default_budget_is_not_capped_by_the_search_subsample():
 
 def test_fit_error_names_the_budget_and_the_count_reached():
     with pytest.raises(FitError) as info:
-        fit_cam_profile(sample_cam("offset_roller"), tolerance=1e-3, max_control_points=20)
+        fit_cam_profile(sample_cam("offset_roller"), tolerance=1e-3, max_control_points=20, name_of=path_of)
     message = str(info.value)
     assert message.startswith(
         "fit.max_control_points: 20 control points are too few for fit.tolerance = 0.001 mm"
@@ -214,7 +215,7 @@ def test_fit_error_names_the_budget_and_the_count_reached():
 
 def test_fit_error_names_the_step_when_the_callers_samples_bind():
     with pytest.raises(FitError) as info:
-        fit_cam_profile(sample_cam("offset_roller"), tolerance=1e-3, step=9.9 * DEG)
+        fit_cam_profile(sample_cam("offset_roller"), tolerance=1e-3, step=9.9 * DEG, name_of=path_of)
     assert str(info.value).startswith("step: ")
     assert "control points" in str(info.value)
     assert "fit.tolerance = 0.001 mm" in str(info.value)

@@ -10,6 +10,7 @@ from numpy.testing import assert_allclose
 from scipy.optimize import minimize_scalar
 
 from camcad.design import load_design, parse_design
+from camcad.design.paths import path_of
 from camcad.errors import UndercutError
 from camcad.geometry import Cam, analyse_geometry, undercut_error
 from tests.conftest import ROOT, make_design
@@ -181,7 +182,7 @@ def test_hren_cam_has_no_cusp_and_a_narrow_face_is_a_hard_limit():
         found = [f for f in geo.findings if f.kind == "face width"]
         assert bool(found) is hard
         if hard:
-            assert found[0].hard and found[0].field == "follower.face_width"
+            assert found[0].hard and path_of(found[0].field) == "follower.face_width"
             assert f"face_width ≥ {math.ceil(needed * 100) / 100:.2f} mm" in found[0].message
 
 

@@ -17,6 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camcad.design import parse_design
+from camcad.design.paths import named_finding, path_of
 from camcad.errors import DesignError
 from camcad.geometry import Cam, analyse_geometry
 from camcad.geometry.limits import conjugate_overlap
@@ -52,8 +53,10 @@ def test_a_pivot_inside_the_swept_circle_is_a_hard_limit(pivot):
     found, reach = _pivot_findings(_rocker(pivot))
     if pivot <= reach:
         (f,) = found
-        assert f.hard and f.field == "follower.pivot_distance"
-        assert f.message.startswith(f"follower.pivot_distance: {pivot:g} mm puts the pivot inside")
+        assert f.hard and path_of(f.field) == "follower.pivot_distance"
+        assert named_finding(f).message.startswith(
+            f"follower.pivot_distance: {pivot:g} mm puts the pivot inside"
+        )
         assert f.limit == pytest.approx(reach, abs=1e-6)  # the true largest radius, not a sample's
     else:
         assert found == []
@@ -127,7 +130,7 @@ def test_the_issues_conjugate_pairs_are_refused(angle):
     data["conjugate"]["angle"] = angle
     with pytest.raises(DesignError) as err:
         parse_design(data)
-    assert err.value.path == "conjugate.angle"
+    assert path_of(err.value.path) == "conjugate.angle"
     assert (
         conjugate_overlap(Cam.from_design(parse_design(INDEXING)).partner(parse_design(INDEXING).conjugate))
         is None

@@ -19,10 +19,12 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.spatial import cKDTree
 
+from camcad.design.paths import path_of
 from camcad.errors import EXIT_INVALID, DesignError, exit_code
 from camcad.findings import Severity
 from camcad.geometry.followers import OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller
 from camcad.geometry.linear import LinearOptions, linear_limits, linear_state
+from camcad.knobs import Knob
 from camcad.motion.laws import make_law
 from camcad.motion.program import MotionProgram
 from camcad.motion.segments import SegmentKind, SegmentSpec
@@ -115,7 +117,7 @@ def test_limits_true_extremes_and_undercut():
     assert not lim.findings
     short = linear_limits(prog, follower, LinearOptions(stroke_length=90.0))
     assert [f.severity for f in short.findings] == [Severity.HARD]
-    assert short.findings[0].field == "cam.stroke_length"
+    assert short.findings[0].field is Knob.STROKE_LENGTH
     assert short.pitch_convex_min.value < 10.0
 
 
@@ -131,12 +133,12 @@ def test_limits_true_extremes_and_undercut():
         (
             TranslatingRoller(base_radius=30.0, roller_radius=10.0),
             LinearOptions(stroke_length=0.0),
-            "cam.stroke_length",
+            "linear.stroke_length",
         ),
         (
             TranslatingRoller(base_radius=30.0, roller_radius=10.0),
             LinearOptions(stroke_length=math.inf),
-            "cam.stroke_length",
+            "linear.stroke_length",
         ),
     ],
     ids=["translating-flat", "oscillating-flat", "zero-stroke", "infinite-stroke"],
@@ -144,7 +146,7 @@ def test_limits_true_extremes_and_undercut():
 def test_bad_input_names_the_field(follower, opt, field):
     with pytest.raises(DesignError) as err:
         linear_state(program().evaluate(PHI), follower, opt)
-    assert err.value.path == field
+    assert path_of(err.value.path) == field
     assert exit_code(err.value) == EXIT_INVALID
 
 

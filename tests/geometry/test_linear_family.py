@@ -18,6 +18,7 @@ from numpy.testing import assert_allclose
 
 from camcad.cli import main
 from camcad.design import parse_design
+from camcad.design.paths import path_of
 from camcad.errors import DesignError
 from camcad.geometry.cam import Cam
 from camcad.geometry.families import family_of
@@ -128,7 +129,7 @@ def test_undercut_is_found_and_named_at_the_pitch_lines_sharpest_convex_point():
     brute = float(np.min(np.where(convex > 0, convex, np.inf)))
     assert brute < RF
     assert result.geometry.undercut is not None
-    assert under[0].field == "linear.stroke_length"
+    assert path_of(under[0].field) == "linear.stroke_length"
     assert under[0].value == pytest.approx(brute, rel=1e-3)
 
 
@@ -166,7 +167,7 @@ def test_bad_linear_input_names_its_field(case):
     change(data)
     with pytest.raises(DesignError) as err:
         parse_design(data)
-    assert err.value.path == field
+    assert path_of(err.value.path) == field
 
 
 def test_a_plate_refuses_the_linear_table():
@@ -174,7 +175,7 @@ def test_a_plate_refuses_the_linear_table():
     data["cam"].pop("style")
     with pytest.raises(DesignError) as err:
         parse_design(data)
-    assert err.value.path == "linear"
+    assert path_of(err.value.path) == "linear"
 
 
 def test_cli_exit_2_names_the_field(tmp_path, capsys):
@@ -214,7 +215,7 @@ def test_a_pivot_below_the_bars_edge_is_a_hard_finding():
     low = dict(ARM, pivot_distance=50.0)
     result = analyse(parse_design(linear_data(follower=low)), fit=False, toolpath=False, strict=False)
     (hit,) = [f for f in result.findings if f.kind == "pivot clearance"]
-    assert hit.hard and hit.field == "follower.pivot_distance"
+    assert hit.hard and path_of(hit.field) == "follower.pivot_distance"
     top = float(
         np.max(
             np.asarray(bar_cam(linear_data(follower=low)).profile(np.linspace(0, 2 * np.pi, 72001)).point)[

@@ -24,6 +24,7 @@ from numpy.testing import assert_allclose
 
 from camcad.cli import main
 from camcad.design import parse_design
+from camcad.design.paths import path_of
 from camcad.errors import DesignError
 from camcad.geometry import Cam, analyse_geometry
 from camcad.geometry.followers import FOLLOWER_TYPES
@@ -155,7 +156,7 @@ def test_face_width_must_cover_the_contacts_slide():
     )
     assert geo.face_width_min == pytest.approx(needed, abs=1e-6)
     (found,) = [f for f in geo.findings if f.kind == "face width"]
-    assert found.field == "follower.face_width" and found.limit == pytest.approx(needed, abs=1e-6)
+    assert path_of(found.field) == "follower.face_width" and found.limit == pytest.approx(needed, abs=1e-6)
     wide = analyse_geometry(cam, max_pressure_angle=math.radians(30.0), face_width=needed + 0.05)
     assert not [f for f in wide.findings if f.kind == "face width"]
 

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from camcad.design.paths import named_error
 from camcad.errors import DesignLimitError, GougeError
 from camcad.geometry.cam import Cam
 from camcad.geometry.tool import check_tool
@@ -49,7 +50,7 @@ def test_tool_larger_than_concave_radius_is_a_gouge_error_naming_the_largest_too
     assert check_tool(cam, 0.999 * smallest) == smallest  # just fits
     with pytest.raises(GougeError) as err:
         check_tool(cam, 15.0)
-    message = str(err.value)
+    message = str(named_error(err.value))  # as the user reads it, its field named by its TOML path
     assert "°" in message and "φ =" in message
     assert f"Ø{2 * smallest:.3f} mm" in message and "gcode.tool_diameter" in message
     assert err.value.max_tool_radius == pytest.approx(smallest)

@@ -15,6 +15,7 @@ from numpy.testing import assert_allclose
 from camcad.geometry.made import made_motion
 from camcad.geometry.sensitivity import Tol, mount_of, pressure_angle_identity, sensitivities
 from tests.inspect.conftest import CAMS
+from tests.named import raises_named
 
 PHI = np.linspace(0.0, 2.0 * np.pi, 361, endpoint=False) + 1e-3
 
@@ -95,7 +96,7 @@ def test_translating_flat_closed_forms():
     assert_allclose(sens.lift[sens.row(Tol.FORM)], 1.0, atol=1e-12)
     assert_allclose(sens.lift[sens.row(Tol.ECCENTRICITY)], 0.0, atol=1e-12)
     assert_allclose(sens.pressure_angle, 0.0, atol=1e-12)
-    with pytest.raises(ValueError, match="roller_radius: does not apply"):
+    with raises_named(ValueError, match="roller_radius: does not apply"):
         sens.row(Tol.ROLLER_RADIUS)
 
 

@@ -24,6 +24,7 @@ from camcad.inspect.tolerance import (
 )
 from tests.conftest import make_design
 from tests.inspect.conftest import CAMS
+from tests.named import raises_named
 
 SMALL = {
     "offset-roller-ccw": [
@@ -99,15 +100,15 @@ def test_monte_carlo_peaks_of_the_design_are_its_true_extremes():
 
 def test_bad_tolerances_are_named():
     cam = CAMS["translating-flat"]()
-    with pytest.raises(DesignError, match=r"tolerance\.roller_radius: does not apply"):
+    with raises_named(DesignError, match=r"tolerance\.roller_radius: does not apply"):
         monte_carlo(cam, [Tolerance(tol=Tol.ROLLER_RADIUS, value=0.01)], samples=10)
-    with pytest.raises(DesignError, match=r"tolerance\.form: -0\.1"):
+    with raises_named(DesignError, match=r"tolerance\.form: -0\.1"):
         linear_dwell(cam, [Tolerance(tol=Tol.FORM, value=-0.1)])
-    with pytest.raises(
+    with raises_named(
         DesignError, match=r"tolerance\.form: ±60 is larger than the part; allowed: below 50 mm"
     ):
         linear_dwell(cam, [Tolerance(tol=Tol.FORM, value=60.0)])
-    with pytest.raises(DesignError, match=r"tolerance\.phase: ±2 is larger than the part"):
+    with raises_named(DesignError, match=r"tolerance\.phase: ±2 is larger than the part"):
         monte_carlo(cam, [Tolerance(tol=Tol.PHASE, value=2.0)], samples=10)
 
 
@@ -167,5 +168,5 @@ def test_weighted_allocation_scales_one_factor():
     # worst dwell: 2·λ + 0.5·2λ = 3λ = 1
     assert out.tolerances[Tol.FORM] == pytest.approx(1 / 3)
     assert out.tolerances[Tol.PHASE] == pytest.approx(2 / 3)
-    with pytest.raises(DesignError, match="dwell_accuracy"):
+    with raises_named(DesignError, match="dwell_accuracy"):
         allocate(coef, (Tol.FORM, Tol.PHASE), required=0.0)

@@ -23,6 +23,7 @@ from camcad.toolpath import MoveKind, Toolpath, check_toolpath, contour, plan_to
 from camcad.toolpath.contour import Step, split_tabs
 from camcad.toolpath.verify import densify, distance_to_polyline
 from tests.conftest import DISC_SAMPLES, make_design
+from tests.named import raises_named
 
 CONFIGS = {
     "climb": {},
@@ -288,7 +289,9 @@ CONCAVE = {"spans": (45.0, 135.0, 45.0, 135.0), "lift": 25.0, "base_radius": 20.
 def test_tool_larger_than_concave_radius_stops_the_plan_with_a_gouge_error():
     design = make_design(**CONCAVE, extra={"gcode": {"tool_diameter": 30.0}})
     cam = Cam.from_design(design)
-    with pytest.raises(GougeError, match=r"set gcode\.tool_diameter below it") as err:
+    with raises_named(
+        GougeError, match=r"^gcode\.tool_diameter: .*\(set the tool diameter below it\)$"
+    ) as err:
         plan_toolpath(cam, design.gcode, name="x", thickness=8.0)
     assert err.value.max_tool_radius == pytest.approx(check_tool(cam, 1.0))
 
@@ -308,22 +311,22 @@ def test_largest_fitting_tool_mills_the_concave_cam_without_gouging():
 
 def test_bad_settings_are_design_errors():
     design, cam, _ = planned("climb")
-    with pytest.raises(DesignError, match=r"gcode\.tolerance"):
+    with raises_named(DesignError, match=r"gcode\.tolerance"):
         plan_toolpath(cam, replace(design.gcode, tolerance=0.0003), name="x", thickness=8.0)
-    with pytest.raises(DesignError, match=r"gcode\.tab_height"):
+    with raises_named(DesignError, match=r"gcode\.tab_height"):
         plan_toolpath(cam, replace(design.gcode, tab_count=2, tab_height=8.0), name="x", thickness=8.0)
-    with pytest.raises(DesignError, match=r"gcode\.tab_width: .* not even one fits"):
+    with raises_named(DesignError, match=r"gcode\.tab_width: .* not even one fits"):
         plan_toolpath(cam, replace(design.gcode, tab_count=1, tab_width=5000.0), name="x", thickness=8.0)
 
 
 def test_too_many_tabs_name_the_count_that_fits():
     """The advised count is the true limit: that many tabs plan, one more does not."""
     design, cam, _ = planned("climb")
-    with pytest.raises(DesignError, match=r"gcode\.tab_count: .* at most (\d+) tab") as info:
+    with raises_named(DesignError, match=r"gcode\.tab_count: .* at most (\d+) tab") as info:
         plan_toolpath(cam, replace(design.gcode, tab_count=40, tab_width=10.0), name="x", thickness=8.0)
     most = int(re.search(r"at most (\d+) tab", str(info.value)).group(1))
     plan_toolpath(cam, replace(design.gcode, tab_count=most, tab_width=10.0), name="x", thickness=8.0)
-    with pytest.raises(DesignError, match=r"gcode\.tab_count"):
+    with raises_named(DesignError, match=r"gcode\.tab_count"):
         plan_toolpath(cam, replace(design.gcode, tab_count=most + 1, tab_width=10.0), name="x", thickness=8.0)
 
 

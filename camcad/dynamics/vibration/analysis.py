@@ -20,6 +20,7 @@ from camcad.dynamics.vibration.response import SpeedMap, TrainResponse, speed_ma
 from camcad.dynamics.vibration.train import train_from_specs
 from camcad.errors import DesignError
 from camcad.findings import Finding, Severity
+from camcad.knobs import Knob
 
 if TYPE_CHECKING:
     from camcad._typing import FloatArray
@@ -174,7 +175,7 @@ def analyse_vibration(
     if vib.compensate_rpm is not None:
         if not spring_loaded:
             raise DesignError(
-                "vibration.compensate_rpm", "a groove or conjugate cam cannot be compensated here; remove it"
+                Knob.COMPENSATE_RPM, "a groove or conjugate cam cannot be compensated here; remove it"
             )
         cam = compensate(program, train, speed_rpm=vib.compensate_rpm)
     lift = program if cam is None else cam
@@ -182,14 +183,14 @@ def analyse_vibration(
     lo = vib.speed_min_rpm if vib.speed_min_rpm is not None else 0.5 * speed_rpm
     hi = vib.speed_max_rpm if vib.speed_max_rpm is not None else 1.5 * speed_rpm
     if not lo < hi:
-        raise DesignError("vibration.speed_max_rpm", f"{hi!r} must exceed speed_min_rpm = {lo!r}")
+        raise DesignError(Knob.VIBRATION_SPEED_MAX, f"{hi!r} must exceed speed_min_rpm = {lo!r}")
     speeds = np.linspace(lo, hi, vib.speed_points) if vib.speed_points > 1 else np.array([lo])
     smap = speed_map(lift, train, speeds_rpm=speeds, spring_loaded=spring_loaded, target=program)
     harmonics = acceleration_harmonics(program)
     findings = list(resonances(response.natural_frequencies, harmonics, speed_rpm=speed_rpm))
     if response.leaves:
         first = response.flights[0].leave if response.flights else response.contact_force_min.phi
-        field = "dynamics.spring_preload_torsional" if arm_angle is not None else "dynamics.spring_preload"
+        field = Knob.SPRING_PRELOAD_TORSIONAL if arm_angle is not None else Knob.SPRING_PRELOAD
         findings.append(
             Finding(
                 kind="leaves the cam",
@@ -216,7 +217,7 @@ def analyse_vibration(
                 Finding(
                     kind="residual vibration",
                     severity=Severity.SOFT,
-                    field="vibration.max_residual",
+                    field=Knob.MAX_RESIDUAL,
                     message=(
                         f"residual vibration of {value:.4g} {unit} in dwell {worst + 1} "
                         f"at {speed_rpm:g} rpm exceeds "

@@ -17,6 +17,7 @@ import numpy as np
 from camcad._typing import FloatArray, readonly
 from camcad.angles import TWO_PI
 from camcad.findings import Finding, Severity
+from camcad.knobs import Knob
 
 if TYPE_CHECKING:
     from camcad.motion.program import MotionProgram
@@ -92,7 +93,7 @@ def resonances(
                 Finding(
                     kind="resonance",
                     severity=Severity.SOFT,
-                    field="vibration.stiffness",
+                    field=Knob.VIBRATION_STIFFNESS,
                     message=(
                         f"the train's natural frequency {wn / TWO_PI:.4g} Hz sits on harmonic {k} of the cam "
                         f"speed {speed_rpm:g} rpm (its acceleration amplitude {amp[k - 1]:.4g}, "

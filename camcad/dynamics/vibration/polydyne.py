@@ -27,6 +27,7 @@ from camcad.angles import TWO_PI
 from camcad.dynamics.vibration._exact import Grid, grid_nodes, hermite, periodic_states, propagate
 from camcad.dynamics.vibration._higher import check_supported, program_derivatives
 from camcad.errors import DesignError
+from camcad.knobs import Knob
 from camcad.motion.program import Breakpoint, Motion, MotionProgram
 from camcad.motion.segments import SegmentKind, SegmentSpec
 
@@ -253,7 +254,7 @@ def compensate(
         enough; ``vibration.compensate_rpm`` for a speed ≤ 0.
     """
     if not (math.isfinite(speed_rpm) and speed_rpm > 0.0):
-        raise DesignError("vibration.compensate_rpm", f"{speed_rpm!r} must be a finite speed > 0 rpm")
+        raise DesignError(Knob.COMPENSATE_RPM, f"{speed_rpm!r} must be a finite speed > 0 rpm")
     check_compensable(program)
     t = train
     if t.dof == 1:

@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass
 
 from camcad.errors import DesignError
+from camcad.knobs import Knob, TableKey
 
 __all__ = ["TrainModel", "VibrationSpec"]
 
@@ -70,19 +71,21 @@ class VibrationSpec:
         key = "stiffness_torsional" if arm else "stiffness"
         rate = self.stiffness_torsional if arm else self.stiffness
         if rate is None:
-            raise DesignError(f"vibration.{key}", "is required (the train's stiffness)")
+            raise DesignError(TableKey(Knob.VIBRATION_TABLE, key), "is required (the train's stiffness)")
         _positive(key, rate)
         if not (0.0 <= self.damping_ratio < 1.0) or not math.isfinite(self.damping_ratio):
-            raise DesignError("vibration.damping_ratio", f"{self.damping_ratio!r} is outside [0, 1)")
+            raise DesignError(Knob.VIBRATION_DAMPING, f"{self.damping_ratio!r} is outside [0, 1)")
         if self.model is TrainModel.TWO_MASS:
             if arm:
                 raise DesignError(
-                    "vibration.model", "'two-mass' is for translating followers; use 'single-mass'"
+                    Knob.VIBRATION_MODEL, "'two-mass' is for translating followers; use 'single-mass'"
                 )
             for name in ("mass_1", "mass_2", "stiffness_2"):
                 value = getattr(self, name)
                 if value is None:
-                    raise DesignError(f"vibration.{name}", "is required by model = 'two-mass'")
+                    raise DesignError(
+                        TableKey(Knob.VIBRATION_TABLE, name), "is required by model = 'two-mass'"
+                    )
                 _positive(name, value)
         lo, hi = self.speed_min_rpm, self.speed_max_rpm
         for name, value in (
@@ -93,19 +96,19 @@ class VibrationSpec:
             if value is not None:
                 _positive(name, value)
         if lo is not None and hi is not None and not lo < hi:
-            raise DesignError("vibration.speed_max_rpm", f"{hi!r} must exceed speed_min_rpm = {lo!r}")
+            raise DesignError(Knob.VIBRATION_SPEED_MAX, f"{hi!r} must exceed speed_min_rpm = {lo!r}")
         if (
             isinstance(self.speed_points, bool)
             or not isinstance(self.speed_points, int)
             or self.speed_points < 1
         ):
-            raise DesignError("vibration.speed_points", f"{self.speed_points!r} is not an integer ≥ 1")
+            raise DesignError(Knob.VIBRATION_SPEED_POINTS, f"{self.speed_points!r} is not an integer ≥ 1")
         if self.speed_points > 10000:
-            raise DesignError("vibration.speed_points", f"{self.speed_points!r} exceeds 10000")
+            raise DesignError(Knob.VIBRATION_SPEED_POINTS, f"{self.speed_points!r} exceeds 10000")
         if self.max_residual is not None:
             _positive("max_residual", self.max_residual)
 
 
 def _positive(name: str, value: float) -> None:
     if not (math.isfinite(value) and value > 0.0):
-        raise DesignError(f"vibration.{name}", f"{value!r} must be a finite number > 0")
+        raise DesignError(TableKey(Knob.VIBRATION_TABLE, name), f"{value!r} must be a finite number > 0")

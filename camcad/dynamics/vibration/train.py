@@ -30,6 +30,7 @@ from camcad.dynamics.spec import DynamicsSpec
 from camcad.dynamics.spring import spring_from_spec
 from camcad.dynamics.vibration.spec import TrainModel, VibrationSpec
 from camcad.errors import DesignError
+from camcad.knobs import Knob
 
 __all__ = ["Train", "train_from_specs"]
 
@@ -155,7 +156,7 @@ def train_from_specs(vib: VibrationSpec, dyn: DynamicsSpec, *, arm_angle: float 
         assert arm_angle is not None and vib.stiffness_torsional is not None
         inertia = dyn.arm_inertia / MM_PER_M
         if inertia <= 0.0:
-            raise DesignError("dynamics.arm_inertia", f"{dyn.arm_inertia!r} must be > 0 for [vibration]")
+            raise DesignError(Knob.ARM_INERTIA, f"{dyn.arm_inertia!r} must be > 0 for [vibration]")
         if dyn.spring_arm is not None:
             rate, preload = dyn.spring_rate * dyn.spring_arm**2, dyn.spring_preload * dyn.spring_arm
         else:
@@ -191,7 +192,7 @@ def train_from_specs(vib: VibrationSpec, dyn: DynamicsSpec, *, arm_angle: float 
             weight=(vib.mass_1 * g, vib.mass_2 * g),
         )
     if dyn.follower_mass <= 0.0:
-        raise DesignError("dynamics.follower_mass", f"{dyn.follower_mass!r} must be > 0 for [vibration]")
+        raise DesignError(Knob.FOLLOWER_MASS, f"{dyn.follower_mass!r} must be > 0 for [vibration]")
     m = dyn.follower_mass / MM_PER_M
     return Train(
         mass=(m,),

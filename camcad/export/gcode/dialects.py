@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from camcad.knobs import Knob
 from camcad.toolpath.spec import Dialect
 
 __all__ = ["DIALECTS", "DialectRules", "dialect_rules"]
@@ -76,4 +77,4 @@ def dialect_rules(dialect: Dialect | str) -> DialectRules:
         from camcad.errors import DesignError
 
         allowed = ", ".join(d.value for d in Dialect)
-        raise DesignError("gcode.dialect", f"{dialect!r} is not allowed (allowed: {allowed})") from None
+        raise DesignError(Knob.DIALECT, f"{dialect!r} is not allowed (allowed: {allowed})") from None

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 from camcad.errors import DesignError
 from camcad.export.gcode.dialects import dialect_rules
 from camcad.export.gcode.writer import GcodeProgram, GcodeSummary, comment_text, count_blocks, program_start
+from camcad.knobs import Knob
 from camcad.toolpath.rotary import ANGLE_DECIMALS, X_DECIMALS
 from camcad.toolpath.spec import Cutter, Dialect, Direction
 
@@ -65,7 +66,7 @@ def _check_dialect(dialect: Dialect) -> None:
     if dialect not in ROTARY_DIALECTS:
         allowed = ", ".join(d.value for d in ROTARY_DIALECTS)
         raise DesignError(
-            "gcode.dialect",
+            Knob.DIALECT,
             f"{dialect.value!r} cannot run a rotary program: grbl has no rotary axis and no G93 "
             f"inverse-time feed (grblHAL has both, but is not a camcad dialect yet); allowed with "
             f"machine = 'rotary': {allowed}",

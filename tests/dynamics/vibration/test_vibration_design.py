@@ -23,6 +23,7 @@ from numpy.testing import assert_allclose
 from camcad.cli import main
 from camcad.cli.render import _vibration_rows
 from camcad.design import load_design, parse_design
+from camcad.design.paths import path_of
 from camcad.dynamics.vibration import Train, TrainModel, VibrationSpec
 from camcad.errors import DesignError
 from camcad.pipeline import OUTPUT_GROUPS, analyse, build
@@ -103,7 +104,7 @@ def test_bad_tables_name_the_field(table, field, words):
     data["vibration"] = table
     with pytest.raises(DesignError) as err:
         parse_design(data)
-    assert err.value.path == field
+    assert path_of(err.value.path) == field
     assert words in str(err.value)
 
 
@@ -112,7 +113,7 @@ def test_an_arm_takes_the_torsional_stiffness():
     data["vibration"] = {"stiffness": 800.0}
     with pytest.raises(DesignError) as err:
         parse_design(data)
-    assert err.value.path == "vibration.stiffness" and "stiffness_torsional" in str(err.value)
+    assert path_of(err.value.path) == "vibration.stiffness" and "stiffness_torsional" in str(err.value)
 
 
 def test_compensating_a_law_not_smooth_enough_names_the_segment():
@@ -120,7 +121,7 @@ def test_compensating_a_law_not_smooth_enough_names_the_segment():
     data["motion"][2] = {"kind": "return", "angle": 120.0, "lift": 25.0, "law": "cycloidal"}
     with pytest.raises(DesignError) as err:
         parse_design(data)
-    assert err.value.path == "motion[2].law"
+    assert path_of(err.value.path) == "motion[2].law"
 
 
 def test_the_json_schema_has_the_table():
@@ -229,7 +230,7 @@ def test_leaving_the_cam_is_a_hard_finding_where_the_flight_starts(tmp_path, cap
     path.write_text(text, encoding="utf-8")
     analysis = analyse(load_design(path), fit=False, toolpath=False, strict=False)
     found = [f for f in analysis.findings if f.kind == "leaves the cam"]
-    assert len(found) == 1 and found[0].hard and found[0].field == "dynamics.spring_preload"
+    assert len(found) == 1 and found[0].hard and path_of(found[0].field) == "dynamics.spring_preload"
     vib = analysis.summary()["vibration"]
     assert vib["leaves_cam"] and vib["periodic"] and len(vib["flights"]) == 2
     assert math.degrees(found[0].angle) == pytest.approx(vib["flights"][0]["leave_deg"], abs=1e-6)
@@ -249,7 +250,7 @@ def test_residual_above_max_residual_is_a_soft_finding(plain):
     data["vibration"]["max_residual"] = 0.01
     analysis = analyse(parse_design(data), fit=False, toolpath=False, strict=False)
     found = [f for f in analysis.findings if f.kind == "residual vibration"]
-    assert len(found) == 1 and not found[0].hard and found[0].field == "vibration.max_residual"
+    assert len(found) == 1 and not found[0].hard and path_of(found[0].field) == "vibration.max_residual"
     assert found[0].value == pytest.approx(max(plain.summary()["vibration"]["residual_mm"]))
     assert "residual vibration" in analysis.violations  # a soft limit: check exits 3
     assert not [f for f in plain.findings if f.kind == "residual vibration"]  # 0.036 mm < 0.05 mm
