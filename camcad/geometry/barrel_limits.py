@@ -22,7 +22,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import DesignError
@@ -164,6 +163,8 @@ class _RibWidth:
         lower = _face_curve(program.evaluate(self.phi), faces[1], options, station).point
         self.period = math.tau * station
         shift = np.array([self.period, 0.0])
+        from scipy.spatial import cKDTree  # a rib's check only: a plate's check loads no SciPy
+
         self.tree = cKDTree(np.vstack((lower - shift, lower, lower + shift)))
 
     def __call__(self, motion: Motion) -> FloatArray:
