@@ -220,7 +220,8 @@ def prove(moves: list[Move], cam: Cam, design: Design) -> Proof:
         keep = np.linalg.norm(travel, axis=1) > 1e-9
         cross = travel[keep, 0] * to_flank[keep, 1] - travel[keep, 1] * to_flank[keep, 0]
         rights.append(bool(np.all(cross < 0.0)))  # the flank on the right of the travel
-    reach = [float(cKDTree(at_depth).query(flank.data)[0].max()) for flank in (inner, outer)]
+    depth_tree = cKDTree(at_depth)  # built once: the reaches below and the groove reach read it
+    reach = [float(depth_tree.query(flank.data)[0].max()) for flank in (inner, outer)]
     # the claim is closest ≥ r − tol: exact below r + 1 − slack, a lower bound above (far points)
     closest = min(float(flank.lower_bounds(cutting[:, :2], r + 1.0).min()) for flank in (inner, outer))
     near = cam.roller_radius + design.groove.clearance  # a search hint only: the groove's half-width and more
@@ -244,7 +245,7 @@ def prove(moves: list[Move], cam: Cam, design: Design) -> Proof:
         and not (k > first_bottom and math.dist(m.end[:2], start) < 1e-3)
     )
     across = np.vstack([exact(cam, d)[::4] for d in np.linspace(inner_d, outer_d, 41)])
-    groove_reach = float(cKDTree(at_depth).query(across)[0].max())
+    groove_reach = float(depth_tree.query(across)[0].max())
     return Proof(
         closed=(closed[0], closed[1]),
         inner_band=bands[0],
