@@ -59,17 +59,32 @@ def sample_path(request: pytest.FixtureRequest) -> Path:
     return request.param
 
 
-def distance_to_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
-    """Distance of each point to a closed polygon (first vertex not repeated), near its nearest vertex."""
+def distance_to_polygon(
+    points: np.ndarray, polygon: np.ndarray, *, beyond: float | None = None
+) -> np.ndarray:
+    """Distance of each point to a closed polygon (first vertex not repeated), near its nearest vertex.
+
+    With ``beyond``, a point whose nearest vertex lies farther than ``beyond`` gets +inf without the slow
+    far search: its true distance exceeds ``beyond`` minus half the longest edge (every point of an edge
+    lies within half its length of a vertex), so a check ``gap <= tol`` or ``median < c`` with
+    ``tol, c`` below that gives the same verdict.
+    """
     n = len(polygon)
-    _, nearest = cKDTree(polygon).query(points)
+    # leaves of 128 vertices: the same nearest vertices as the default 16, found faster on dense curves
+    d, nearest = cKDTree(polygon, leafsize=128).query(
+        points, distance_upper_bound=np.inf if beyond is None else beyond
+    )
+    near = np.isfinite(d)
+    points, nearest = points[near], nearest[near]
     dist = np.full(len(points), np.inf)
     for shift in (-1, 0):
         i = (nearest + shift) % n
         p, q = polygon[i], polygon[(i + 1) % n]
         t = np.clip(np.einsum("ij,ij->i", points - p, q - p) / np.einsum("ij,ij->i", q - p, q - p), 0, 1)
         dist = np.minimum(dist, np.linalg.norm(points - (p + t[:, None] * (q - p)), axis=1))
-    return dist
+    out = np.full(len(near), np.inf)
+    out[near] = dist
+    return out
 
 
 @contextmanager

@@ -439,7 +439,7 @@ def _signed_pressure_deg(cam: Any, phi: np.ndarray) -> tuple[float, float]:
         alpha = cam.state(p, side=side).pressure_angle
         return np.vstack((alpha, alpha))
 
-    hi, lo = extremes_rows(rows, phi, joints, ("max", "min"))
+    hi, lo = extremes_rows(rows, phi, joints, ("max", "min"), rests=cam.rests)  # α is constant on a dwell
     return math.degrees(hi.value), math.degrees(lo.value)
 
 

@@ -130,7 +130,8 @@ def feasible_margins(
             st = plate.state(p, side=side)
             return np.vstack((np.abs(st.pressure_angle), plate.loop_radius(st) - plate.roller_radius))
 
-        worst_alpha, worst_rho = extremes_rows(rows, phi, joints, ("max", "min"))
+        # on a dwell both rows are constant (the follower stands still): no search there, as in limits
+        worst_alpha, worst_rho = extremes_rows(rows, phi, joints, ("max", "min"), rests=plate.rests)
         found.append((worst_alpha, worst_rho))
     worst_alpha = max((a for a, _ in found), key=lambda e: e.value)
     worst_rho = min((r for _, r in found), key=lambda e: e.value)

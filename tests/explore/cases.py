@@ -44,3 +44,23 @@ def peak_pressure_angle_002(s: np.ndarray, v: np.ndarray, *, r_b: float, e: floa
     """max |α| [deg] over the samples by 002 eq. 4."""
     k = math.sqrt((r_b + r_f) ** 2 - e * e)
     return float(np.degrees(np.max(np.abs(np.arctan2(v - e, s + k)))))
+
+
+def peak_pressure_angles_002(
+    s: np.ndarray, v: np.ndarray, *, r_b: float, offsets: np.ndarray, r_f: float
+) -> np.ndarray:
+    """max |α| [deg] over the samples by 002 eq. 4 at each of many offsets (one r_b).
+
+    The value of :func:`peak_pressure_angle_002` at each offset, with one arctan per offset instead of one
+    per sample: where s + k > 0, α = arctan((v − e)/(s + k)), and arctan is odd and increasing, so
+    max |α| = arctan(max |v − e|/(s + k)).
+    """
+    offsets = np.asarray(offsets, dtype=float)
+    ratio = np.empty(offsets.shape)
+    num, den = np.empty_like(s), np.empty_like(s)
+    for i, e in enumerate(offsets):
+        np.add(s, math.sqrt((r_b + r_f) ** 2 - e * e), out=den)
+        assert den.min() > 0.0  # the identity above needs the follower outside the base circle
+        np.abs(np.subtract(v, e, out=num), out=num)
+        ratio[i] = np.max(np.divide(num, den, out=num))
+    return np.degrees(np.arctan(ratio))

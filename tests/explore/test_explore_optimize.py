@@ -25,6 +25,7 @@ from tests.conftest import ROOT
 from tests.explore.cases import (
     motion_sv,
     peak_pressure_angle_002,
+    peak_pressure_angles_002,
     sample_data,
     smallest_base_radius_002,
 )
@@ -212,11 +213,17 @@ def test_pareto_front_against_brute_force():
     assert front[0][0] == pytest.approx(23.423, abs=2e-3) and front[0][1] == pytest.approx(25.0, abs=1e-4)
     assert front[-1][0] == pytest.approx(60.0)
     for r_b, alpha in front:  # at its own r_b no offset gives a smaller peak pressure angle
-        best = min(peak_pressure_angle_002(s, v, r_b=r_b, e=e, r_f=R_F) for e in offsets)
+        peaks = peak_pressure_angles_002(s, v, r_b=r_b, offsets=offsets, r_f=R_F)
+        # the vectorised form is 002 eq. 4 itself (its docstring's identity): spot-check it per sample
+        for j in (0, 777, len(offsets) - 1, int(np.argmin(peaks))):
+            assert peaks[j] == pytest.approx(peak_pressure_angle_002(s, v, r_b=r_b, e=offsets[j], r_f=R_F))
+        best = float(peaks.min())
         assert best - 0.01 <= alpha <= best + 1e-4
+    coarse = np.arange(0.0, 20.01, 0.5)
     for r_b in np.arange(20.0, 60.01, 0.5):
-        for e in np.arange(0.0, 20.01, 0.5):
-            alpha = peak_pressure_angle_002(s, v, r_b=r_b, e=e, r_f=R_F)
+        for e, alpha in zip(
+            coarse, peak_pressure_angles_002(s, v, r_b=r_b, offsets=coarse, r_f=R_F), strict=True
+        ):
             assert not any(r_b < p[0] - 1e-6 and alpha < p[1] - 1e-4 for p in front), (r_b, e)
 
 

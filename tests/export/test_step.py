@@ -233,11 +233,17 @@ def test_the_same_design_gives_the_same_bytes_written_twice(case, tmp_path):
 
 def test_bytes_do_not_depend_on_the_process(tmp_path):
     """A fresh interpreter with another hash seed writes the same file: no clock, no random ids."""
+    # DESIGNS['roller-keyed'] and cam_and_fit spelled out: importing this module would load OpenCASCADE
+    # (~3 s a process) for nothing, the writer does not use it
     script = (
         f"import sys; sys.path.insert(0, {str(ROOT)!r})\n"
-        "from tests.export.test_step import DESIGNS, cam_and_fit\n"
+        "from tests.conftest import make_design\n"
         "from camcad.export.step import write_cam_step\n"
-        "design = DESIGNS['roller-keyed'](); cam, fit = cam_and_fit(design)\n"
+        "from camcad.fit import fit_cam_profile\n"
+        "from camcad.geometry.cam import Cam\n"
+        f"design = make_design(extra={KEYED!r})\n"
+        "fit = fit_cam_profile(Cam.from_design(design), tolerance=design.fit.tolerance,"
+        " max_control_points=design.fit.max_control_points)\n"
         "write_cam_step(sys.argv[1], fit=fit, plate=design.plate())\n"
     )
     paths = []
@@ -252,6 +258,11 @@ def test_bytes_do_not_depend_on_the_process(tmp_path):
         assert run.stdout == ""  # the writer prints nothing
         paths.append(target)
     assert paths[0].read_bytes() == paths[1].read_bytes()
+    design = DESIGNS["roller-keyed"]()  # the same design and fit as the script's
+    _, fit = cam_and_fit(design)
+    (tmp_path / "here").mkdir()  # the file's name is in its header: the same name
+    here = write_cam_step(tmp_path / "here" / "cam.step", fit=fit, plate=design.plate())
+    assert here.read_bytes() == paths[0].read_bytes()
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

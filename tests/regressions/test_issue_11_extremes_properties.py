@@ -58,11 +58,17 @@ def designs(draw):
     )
 
 
-def brute(cam: Cam, quantity) -> np.ndarray:
-    """quantity(phi, side) on 10^6 angles and both sides of every joint, concatenated."""
+def dense_arrays(cam: Cam) -> list[tuple[np.ndarray, object, object, np.ndarray]]:
+    """(angles, motion, profile, pressure angle) on 10^6 angles and on both sides of every joint.
+
+    Each exact function is evaluated once per (angles, side); every brute-force quantity below reads these.
+    """
     phi = np.linspace(0.0, 2 * math.pi, N_DENSE, endpoint=False)
     joints = np.array([bp.phi for bp in cam.program.breakpoints])
-    return np.concatenate([quantity(phi, "right"), quantity(joints, "left"), quantity(joints, "right")])
+    return [
+        (p, cam.motion(p, side=side), cam.profile(p, side=side), cam.pressure_angle(p, side=side))
+        for p, side in ((phi, "right"), (joints, "left"), (joints, "right"))
+    ]
 
 
 def agrees(reported: float, values: np.ndarray, kind: str) -> bool:
@@ -81,32 +87,31 @@ def test_every_reported_extreme_is_the_brute_force_extreme(design):
     cam = result.cam
     geo, dyn, mot = summary["geometry"], summary["dynamics"], summary["motion"]
 
-    alpha = brute(cam, lambda p, side: np.abs(cam.pressure_angle(p, side=side)))
+    arrays = dense_arrays(cam)
+
+    def brute(quantity) -> np.ndarray:
+        """quantity(motion, profile, pressure angle) on 10^6 angles and both sides of every joint."""
+        return np.concatenate([quantity(m, prof, pa) for _, m, prof, pa in arrays])
+
+    alpha = brute(lambda m, prof, pa: np.abs(pa))
     assert agrees(math.radians(geo["pressure_angle_max_deg"]), alpha, "max")
-    rho = brute(cam, lambda p, side: cam.profile(p, side=side).rho)
+    rho = brute(lambda m, prof, pa: prof.rho)
     if geo["curvature_radius_min_mm"] is not None:
         assert agrees(geo["curvature_radius_min_mm"], np.where(rho > 0, rho, np.inf), "min")
     if geo["concave_radius_min_mm"] is not None:
         assert agrees(geo["concave_radius_min_mm"], np.where(rho < 0, -rho, np.inf), "min")
-    radius = brute(cam, lambda p, side: np.hypot(*cam.profile(p, side=side).point.T))
+    radius = brute(lambda m, prof, pa: np.hypot(*prof.point.T))
     assert agrees(geo["profile_radius_min_mm"], radius, "min")
     assert agrees(geo["profile_radius_max_mm"], radius, "max")
     for key, unit in (("v", "mm_per_rad"), ("a", "mm_per_rad2"), ("j", "mm_per_rad3")):
-        values = brute(cam, lambda p, side, key=key: np.abs(getattr(cam.motion(p, side=side), key)))
+        values = brute(lambda m, prof, pa, key=key: np.abs(getattr(m, key)))
         assert agrees(mot[f"{key}_max_abs_{unit}"], values, "max")
 
-    def dynamics(p, side):
+    def dynamics(m, prof, pa):
         """The samples-only analysis (no cam given) at these angles: its arrays, brute force."""
-        return analyse_dynamics(
-            cam.motion(p, side=side),
-            pressure_angle=cam.pressure_angle(p, side=side),
-            profile_rho=cam.profile(p, side=side).rho,
-            setup=design.dynamics_setup(),
-        )
+        return analyse_dynamics(m, pressure_angle=pa, profile_rho=prof.rho, setup=design.dynamics_setup())
 
-    phi = np.linspace(0.0, 2 * math.pi, N_DENSE, endpoint=False)
-    joints = np.array([bp.phi for bp in cam.program.breakpoints])
-    parts = [dynamics(phi, "right"), dynamics(joints, "left"), dynamics(joints, "right")]
+    parts = [dynamics(m, prof, pa) for _, m, prof, pa in arrays]
     force = np.concatenate([r.contact_force for r in parts])
     torque = np.concatenate([r.torque for r in parts])
     stress = np.concatenate([r.hertz_stress for r in parts])

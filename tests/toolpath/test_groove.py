@@ -130,11 +130,41 @@ class Curve:
 
     def __init__(self, pts: np.ndarray) -> None:
         self.data = pts[:-1]  # the last point repeats the first
-        self.tree = cKDTree(self.data)
+        # leaves of 128 vertices: the same nearest vertices as the default 16, found faster for 10⁶ queries
+        self.tree = cKDTree(self.data, leafsize=128)
+        # every point of the polyline lies within half its longest segment of a vertex
+        self.slack = 0.5 * float(np.linalg.norm(np.diff(pts, axis=0), axis=1).max())
 
-    def query(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Distance [mm] from points q (n, 2) to the polyline, and the nearest vertex's index."""
-        _, j = self.tree.query(q)
+    def query(self, q: np.ndarray, *, near: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Distance [mm] from points q (n, 2) to the polyline, and the nearest vertex's index.
+
+        ``near`` [mm] only speeds the search: the vertices within it are searched first (a bounded
+        search is fast), the unbounded search only for the points left; the answers are the same.
+        """
+        if near is None:
+            _, j = self.tree.query(q)
+        else:
+            d, j = self.tree.query(q, distance_upper_bound=near)
+            far = ~np.isfinite(d)
+            if far.any():
+                j[far] = self.tree.query(q[far])[1]
+        return self._to_segments(q, j), j
+
+    def lower_bounds(self, q: np.ndarray, beyond: float) -> np.ndarray:
+        """Distances [mm] from points q (n, 2) to the polyline, exact where a vertex lies within ``beyond``.
+
+        Elsewhere the lower bound ``beyond`` − :attr:`slack`: such a point's nearest polyline point is
+        within :attr:`slack` of a vertex, more than ``beyond`` away. So the minimum is exact whenever it
+        is below ``beyond`` − slack, and the slow far searches are skipped.
+        """
+        d, j = self.tree.query(q, distance_upper_bound=beyond)
+        near = np.isfinite(d)
+        out = np.full(len(q), beyond - self.slack)
+        out[near] = self._to_segments(q[near], j[near])
+        return out
+
+    def _to_segments(self, q: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """Distance [mm] from points q (n, 2) to the two segments at their nearest vertices j."""
         n = len(self.data)
         best = np.full(len(q), np.inf)
         for a_at, b_at in ((j - 1, j), (j, j + 1)):
@@ -142,7 +172,7 @@ class Curve:
             w = b - a
             t = np.clip(np.einsum("ij,ij->i", q - a, w) / np.einsum("ij,ij->i", w, w), 0.0, 1.0)
             best = np.minimum(best, np.linalg.norm(q - (a + w * t[:, None]), axis=1))
-        return best, j
+        return best
 
 
 def _nearest(curve: Curve, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -192,9 +222,12 @@ def prove(moves: list[Move], cam: Cam, design: Design) -> Proof:
         keep = np.linalg.norm(travel, axis=1) > 1e-9
         cross = travel[keep, 0] * to_flank[keep, 1] - travel[keep, 1] * to_flank[keep, 0]
         rights.append(bool(np.all(cross < 0.0)))  # the flank on the right of the travel
-    reach = [float(cKDTree(at_depth).query(flank.data)[0].max()) for flank in (inner, outer)]
-    closest = min(float(_nearest(flank, cutting[:, :2])[0].min()) for flank in (inner, outer))
-    off_centre = float(_nearest(pitch, cutting[:, :2])[0].max())
+    depth_tree = cKDTree(at_depth)  # built once: the reaches below and the groove reach read it
+    reach = [float(depth_tree.query(flank.data)[0].max()) for flank in (inner, outer)]
+    # the claim is closest ≥ r − tol: exact below r + 1 − slack, a lower bound above (far points)
+    closest = min(float(flank.lower_bounds(cutting[:, :2], r + 1.0).min()) for flank in (inner, outer))
+    near = cam.roller_radius + design.groove.clearance  # a search hint only: the groove's half-width and more
+    off_centre = float(pitch.query(cutting[:, :2], near=near)[0].max())
     lap = _planar(exact(cam, cam.roller_radius))
     start = np.asarray(cam.offset_curve(np.array([spec.start_angle]), cam.roller_radius).point[0])
     ramp = [m for m in feeds if m.end[2] < m.start[2] - 1e-9 and math.dist(m.start[:2], m.end[:2]) > 1e-9]
@@ -214,7 +247,7 @@ def prove(moves: list[Move], cam: Cam, design: Design) -> Proof:
         and not (k > first_bottom and math.dist(m.end[:2], start) < 1e-3)
     )
     across = np.vstack([exact(cam, d)[::4] for d in np.linspace(inner_d, outer_d, 41)])
-    groove_reach = float(cKDTree(at_depth).query(across)[0].max())
+    groove_reach = float(depth_tree.query(across)[0].max())
     return Proof(
         closed=(closed[0], closed[1]),
         inner_band=bands[0],
