@@ -36,8 +36,13 @@ from camcad.errors import (
 __all__ = ["build_parser", "main"]
 
 
+_INTERRUPTS: list[int] = []
+"""The signals that interrupted this run: an import the signal broke may surface as another error."""
+
+
 def _interrupt(signum: int, frame: FrameType | None) -> None:
-    """SIGTERM and SIGHUP end a run like Ctrl-C: clean up, exit 130."""
+    """SIGINT, SIGTERM and SIGHUP end a run alike: noted, then KeyboardInterrupt (clean up, exit 130)."""
+    _INTERRUPTS.append(signum)
     raise KeyboardInterrupt
 
 
@@ -111,7 +116,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     code = EXIT_INTERRUPTED
     try:
         if threading.current_thread() is threading.main_thread():
-            previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+            _INTERRUPTS.clear()
+            previous = signal.signal(signal.SIGINT, _interrupt)
         try:
             code = _run(argv)
         except KeyboardInterrupt:  # a signal while an error line was printed
@@ -167,6 +173,9 @@ def _run(argv: Sequence[str] | None) -> int:
         _say("error", f"{err.strerror or err}{where}")
         return exit_code(err)
     except Exception as err:  # the one place that maps surprises to exit 1
+        if _INTERRUPTS:  # the signal broke an import (numpy turns it into an ImportError): an interrupt
+            print("camcad: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
         _say("unexpected error", f"{type(err).__name__}: {err}")
         print("camcad: please report this with your design file", file=sys.stderr)
         return EXIT_UNEXPECTED

@@ -203,7 +203,7 @@ class BarrelFamily:
     def __init__(self, kind: BarrelKind = BarrelKind.GROOVE) -> None:
         self.kind = kind
         self.rib = kind is BarrelKind.RIB
-        self.name = "barrel rib" if self.rib else "barrel"
+        self.name = "barrel-rib" if self.rib else "barrel"
         keys = {
             "cam.barrel_radius",
             "cam.length",
