@@ -334,3 +334,22 @@ def test_an_arm_that_runs_the_groove_backwards_is_refused_as_crossing_itself(tmp
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
     assert "follower.arm_length" in err and "crosses itself" in err
+
+
+def test_a_barrel_build_without_opencascade_is_one_line_and_exit_2(tmp_path):
+    """Without the ``step`` extra (OCP made unimportable in a fresh interpreter) the build says what to
+    install or leave out, exit 2, and writes nothing."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    code = (
+        "import sys; sys.modules['OCP'] = None\n"  # what an environment without the extra gives
+        "from camcad.cli import main\n"
+        f"raise SystemExit(main(['build', {str(SAMPLES['indexer'])!r}, '-o', {str(out)!r}, '-q']))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 2, proc.stderr
+    (line,) = proc.stderr.strip().splitlines()
+    assert line.startswith("camcad: error: --only: ") and "pip install 'camcad[step]'" in line
+    assert not out.exists()

@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camcad.errors import ExportError
+from camcad.errors import UsageError
 from camcad.export.atomic import atomic_write, atomic_write_bytes
 from camcad.export.barrel_dxf import developed_groove, write_developed_dxf
 from camcad.export.barrel_mesh import BarrelMeshOptions, barrel_mesh, barrel_stl_bytes
@@ -52,15 +52,21 @@ def write_barrel_step(folder: str | os.PathLike[str], part: Part, *, fit: Barrel
 
     Raises
     ------
+    UsageError
+        OpenCASCADE (``pip install camcad[step]``) is missing: exit 2, naming ``--only``.
     ExportError
-        OpenCASCADE (``pip install camcad[step]``) is missing, or its solid is not one valid solid.
+        Its solid is not one valid solid.
     """
     b = _barrel(part)
     try:
+        import OCP  # noqa: F401  # the step extra; barrel_step imports its parts where it uses them
+
         from camcad.export.barrel_step import barrel_shape, barrel_step_bytes
-    except ImportError as err:  # pragma: no cover - the step extra is installed with the tests
-        raise ExportError(
-            f"a barrel's cam.step needs OpenCASCADE: pip install 'camcad[step]' ({err})"
+    except ImportError as err:
+        raise UsageError(
+            "--only",
+            "a barrel's cam.step needs OpenCASCADE, which is not installed: pip install 'camcad[step]', "
+            "or leave the STEP file out (--only tables,dxf,stl,gcode,report)",
         ) from err
     solid = barrel_shape(fit, b.options)
     return atomic_write_bytes(Path(folder) / f"cam{part.suffix}.step", barrel_step_bytes(solid, name=name))
