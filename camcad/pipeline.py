@@ -19,8 +19,6 @@ from functools import lru_cache, partial
 from pathlib import Path
 from typing import Any, cast
 
-import numpy as np
-
 from camcad.analysis import Analysis, PartResult, motion_summary
 from camcad.design import Design, load_design
 from camcad.design.paths import named_error, named_finding, named_findings, names_its_errors, path_of
@@ -746,10 +744,16 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
     unit = cam.follower_spec.kind.lift_unit  # mm on a slide, degrees of swing on an arm
     duty = analysis.duty.csv_columns() if analysis.duty is not None else {}  # the first part's film
     duty |= analysis.drive.csv_columns() if analysis.drive is not None else {}  # the train's motor torque
-    duty |= _later_part_columns(analysis)
     motion_csv = write_motion_csv(folder / "motion.csv", cam, unit=unit)
     profile_csv = write_profile_csv(folder / "profile.csv", analysis.geometry)
-    dynamics_csv = write_dynamics_csv(folder / "dynamics.csv", analysis.dynamics, extra=duty or None)
+    later = [  # every further part with files of its own (a pair's second plate): its columns too
+        (r.part.suffix, r.dynamics, r.duty.csv_columns() if r.duty is not None else {})
+        for r in analysis.parts[1:]
+        if r.part.suffix
+    ]
+    dynamics_csv = write_dynamics_csv(
+        folder / "dynamics.csv", analysis.dynamics, extra=duty or None, later_parts=later
+    )
     return [
         motion_csv,
         profile_csv,
@@ -760,26 +764,6 @@ def write_tables(analysis: Analysis, folder: Path) -> list[Path]:
         *_drive_table(analysis, folder),
         *_vibration_tables(analysis, folder),
     ]
-
-
-def _later_part_columns(analysis: Analysis) -> dict[str, Any]:
-    """Every later part's own ``dynamics.csv`` columns, named with its files' suffix (a pair's ``_2``).
-
-    The same figures as the first part's (contact force, Hertz stress, then its
-    film), by the same code, on the same angles: a conjugate pair's second
-    plate gets ``contact_force_N_2``, ``hertz_stress_MPa_2``, ``film_ratio_2``.
-    """
-    first = analysis.dynamics.phi
-    out: dict[str, Any] = {}
-    for later in analysis.parts[1:]:
-        dyn, sfx = later.dynamics, later.part.suffix
-        if not sfx or dyn.phi.shape != first.shape or not np.array_equal(dyn.phi, first):
-            continue  # a part on other angles, or without files of its own, has no columns here
-        out[f"contact_force_N{sfx}"] = dyn.contact_force
-        out[f"hertz_stress_MPa{sfx}"] = dyn.hertz_stress
-        if later.duty is not None:
-            out |= {f"{key}{sfx}": column for key, column in later.duty.csv_columns().items()}
-    return out
 
 
 def _vibration_tables(analysis: Analysis, folder: Path) -> list[Path]:

@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -344,9 +345,19 @@ def write_profile_csv(path: str | os.PathLike[str], geometry: GeometryAnalysis) 
 
 
 def write_dynamics_csv(
-    path: str | os.PathLike[str], dynamics: DynamicsResult, *, extra: dict[str, FloatArray] | None = None
+    path: str | os.PathLike[str],
+    dynamics: DynamicsResult,
+    *,
+    extra: dict[str, FloatArray] | None = None,
+    later_parts: Sequence[tuple[str, DynamicsResult, dict[str, FloatArray]]] = (),
 ) -> Path:
-    """``dynamics.csv``: contact force [N], torque [N·mm], Hertz stress [MPa], then ``extra``'s columns."""
+    """``dynamics.csv``: contact force [N], torque [N·mm], Hertz stress [MPa], then ``extra``'s columns.
+
+    ``later_parts``: (files' suffix, dynamics, extra columns) of every further
+    part (a pair's second plate, ``_2``): its contact force, Hertz stress and
+    extra columns follow, each name ending in its suffix, the same figures as
+    the first part's. A part on other angles than the first has none here.
+    """
     dyn = dynamics
     columns = {
         "angle_deg": np.degrees(dyn.phi),
@@ -355,4 +366,10 @@ def write_dynamics_csv(
         "hertz_stress_MPa": dyn.hertz_stress,
         **(extra or {}),
     }
+    for sfx, part, more in later_parts:
+        if part.phi.shape != dyn.phi.shape or not np.array_equal(part.phi, dyn.phi):
+            continue
+        columns[f"contact_force_N{sfx}"] = part.contact_force
+        columns[f"hertz_stress_MPa{sfx}"] = part.hertz_stress
+        columns |= {f"{key}{sfx}": column for key, column in more.items()}
     return write_csv(path, columns)
