@@ -133,3 +133,18 @@ RIB = BarrelCase(
     ),
     toml=(ROOT / "samples" / "barrel_rib.toml").read_text(encoding="utf-8"),
 )
+
+
+def assert_same_outputs(first: Path, again: Path) -> None:
+    """Two builds of one design wrote the same files: the same bytes, summary.json's figures alike."""
+    import json
+
+    names = sorted(p.name for p in first.iterdir())
+    assert names == sorted(p.name for p in again.iterdir())
+    for n in names:
+        if n == "summary.json":  # timings aside, the figures are the same
+            a = json.loads((first / n).read_text(encoding="utf-8"))
+            b = json.loads((again / n).read_text(encoding="utf-8"))
+            assert a == b
+            continue
+        assert (first / n).read_bytes() == (again / n).read_bytes(), n
