@@ -115,7 +115,11 @@ def distance_to_curve(points: np.ndarray, curve: np.ndarray) -> np.ndarray:
     best = np.full(len(points), np.inf)
     for lo in (np.maximum(k - 1, 0), np.minimum(k, len(curve) - 2)):
         a, ab = curve[lo], curve[lo + 1] - curve[lo]
-        t = np.clip(np.einsum("ij,ij->i", points - a, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
+        t = np.clip(
+            np.einsum("ij,ij->i", points - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300),
+            0.0,
+            1.0,
+        )
         best = np.minimum(best, np.hypot(*(points - a - t[:, None] * ab).T))
     return best
 
