@@ -4,8 +4,8 @@ The bar's blank is squared beforehand; the program mills its top edge, the
 cam, through the bar's thickness: roughing passes at the tool radius plus
 the stock to leave, one per ``step_down`` level, then one finishing pass at
 the tool radius, each along the exact offset curve ``cam.offset_curve(φ, r)`` from
-one end of the bar to the other, entering and leaving along the edge's end
-tangents outside the bar (straight G1 leads, tangent to the path).
+one end of the bar to the other, entering and leaving outside the bar on
+straight G1 leads along the path's own end tangents.
 
 Direction, by the plate's rule (:mod:`camcad.toolpath.plan`: M3 turns the
 spindle clockwise seen from +Z, and climb milling has the part on the tool's
@@ -14,7 +14,7 @@ x0 to x0 + L, and conventional the other way.
 
 The offset curve is an arc spline as on a plate (:func:`~camcad.toolpath.contour.fit_open_path`:
 the layered arc search of :mod:`camcad.toolpath.arcs` on the open curve,
-from the curve's start to its end on their own tangents), fitted within the
+from the curve's start on its tangent to its end), fitted within the
 plate's band (``_fit_tolerance`` of :mod:`camcad.toolpath.plan`), rounded to the
 written 4 decimals with each arc's I/J from its rounded start, and measured
 two-way against the exact curve after rounding; the roughing path is the

@@ -375,7 +375,7 @@ class OpenPath:
 
     The open counterpart of :class:`Contour` (a linear cam's edge,
     :func:`camcad.toolpath.bar.plan_bar`): its ends lie on the exact curve's
-    ends (rounded), where the arc spline takes the curve's own tangents.
+    ends (rounded); its end tangents are the arc spline's own there.
     """
 
     steps: tuple[Step, ...]
@@ -411,11 +411,13 @@ def fit_open_path(
 
     The arc spline (:func:`~camcad.toolpath.arcs.spline.fit_arc_spline`, not
     closed) starts on the exact curve at ``breaks[0]`` with its tangent and
-    ends on it at ``breaks[-1]`` with its tangent; every break in between is
-    a node on the curve. ``reverse`` travels from the last break to the first.
-    ``tol`` and ``fit_tol`` [mm] as for :func:`fit_contour`: the deviation is
-    measured after rounding, two-way, and must be within ``tol``. ``arcs``
-    False writes G1 chords only (for comparison).
+    ends on it at ``breaks[-1]`` (by a biarc on its tangent, or an arc that
+    lands there, its tangent within the band's); every break in between is
+    a node on the curve. The path's end tangents are its own. ``reverse``
+    travels from the last break to the first. ``tol`` and ``fit_tol`` [mm]
+    as for :func:`fit_contour`: the deviation is measured after rounding,
+    two-way, and must be within ``tol``. ``arcs`` False writes G1 chords
+    only (for comparison).
     """
     curve = offset_curve(cam, distance)
     try:
@@ -451,7 +453,9 @@ def _realise_open(curve: CurveFn, distance: float, pieces: Pieces, tol: float, *
     dev = float(measure_deviation(curve, real, samples=48).max())
     if dev > tol:  # pragma: no cover - the fit keeps a margin for rounding
         raise DesignLimitError(f"toolpath deviation {dev:.5f} mm exceeds the tolerance {tol:g} mm")
-    t_lo, t_hi = _end_tangents(pieces)
+    starts, ends = pieces.tangents()
+    live = np.flatnonzero(pieces.length().reshape(-1) > 0.0)  # a null piece has no tangent
+    t_lo, t_hi = starts.reshape(-1, 2)[live[0]], ends.reshape(-1, 2)[live[-1]]
     t_start, t_end = (-t_hi, -t_lo) if reverse else (t_lo, t_hi)
     return OpenPath(
         steps=tuple(_merge(steps)),
