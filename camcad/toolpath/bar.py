@@ -39,6 +39,8 @@ from camcad.toolpath.spec import Direction, GcodeSpec
 
 __all__ = ["plan_bar"]
 
+_NO_REFIT = "the fewest-arcs refit thins closed contours only: the edge keeps the search's arcs"
+
 
 def plan_bar(
     cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float, arcs: bool = True
@@ -134,5 +136,6 @@ def plan_bar(
             f"linear cam bar: open edge cut from X{bar.x0:.4f} to X{x1:.4f}, bottom at Y{bar.bottom:.4f}; "
             "the blank is squared beforehand",
             *([f"no tabs on a bar edge ({spec.name_of(Knob.TAB_COUNT)} ignored)"] if spec.tab_count else []),
+            *([_NO_REFIT] if spec.fewest_arcs and arcs else []),
         ),
     )

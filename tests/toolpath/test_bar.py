@@ -117,3 +117,14 @@ def test_g1_chords_of_the_bar_need_several_times_the_blocks_of_its_arcs():
     assert chords.max_deviation <= design.gcode.tolerance
     assert all(not m.kind.is_arc for m in chords.moves)
     assert chords.contour_blocks >= 3 * arcs.contour_blocks
+
+
+def test_the_fewest_arcs_refit_leaves_an_open_edge_as_searched_and_says_so():
+    cam, bar, design = bar_case()
+    plain = plan_bar(cam, bar, design.gcode, name="bar", thickness=design.cam.thickness)
+    asked = plan_bar(
+        cam, bar, replace(design.gcode, fewest_arcs=True), name="bar", thickness=design.cam.thickness
+    )
+    assert asked.moves == plain.moves
+    assert any("fewest-arcs" in note for note in asked.notes)
+    assert not any("fewest-arcs" in note for note in plain.notes)
