@@ -313,7 +313,10 @@ ARC_MAX_ROUNDS = 40  # halvings of an interval: 2π/2^40 rad is far below any re
 
 
 def arc_outline(curve: CurveFn, breakpoints: Sequence[float], tolerance: float) -> tuple[Pieces, FloatArray]:
-    """Tangent-continuous arcs through a closed curve C(φ), φ ∈ [0, 2π), within ``tolerance`` [mm].
+    """Tangent-continuous arcs through a curve C(φ), φ ∈ [0, 2π], within ``tolerance`` [mm].
+
+    A closed curve (a plate's profile) closes where C(2π) = C(0); an open one
+    (a linear cam's edge) runs from its exact start C(0) to its exact end C(2π).
 
     Parameters
     ----------

@@ -278,8 +278,14 @@ def _add_bore_exact(msp: Modelspace, bore: BoreOutline) -> None:
     spline.knots = knots  # type: ignore[assignment]
 
 
-def _add_arcs(msp: Modelspace, pieces: Pieces, layer: str) -> None:
-    """ARC and LINE entities of biarc pieces (empty pieces skipped); an ARC runs ccw, so cw arcs swap ends."""
+def _add_arcs(msp: Modelspace, pieces: Pieces, layer: str, *, positive_angles: bool = False) -> None:
+    """ARC and LINE entities of biarc pieces (empty pieces skipped); an ARC runs ccw, so cw arcs swap ends.
+
+    Angles are written in (−180°, 180°], or with ``positive_angles`` in
+    [0°, 360°): LibreCAD (2.2) draws an ARC whose start angle is exactly −90°
+    as a full circle, which a linear cam's edge meets where it starts (x = 0)
+    on a horizontal tangent; a plate's profile never lands on exactly −90°.
+    """
     attribs = {"layer": layer}
     for k in range(len(pieces)):
         for j in range(2):
@@ -294,6 +300,8 @@ def _add_arcs(msp: Modelspace, pieces: Pieces, layer: str) -> None:
             a1 = math.degrees(math.atan2(end[1] - centre[1], end[0] - centre[0]))
             if not pieces.ccw[k, j]:
                 a0, a1 = a1, a0
+            if positive_angles:
+                a0, a1 = a0 % 360.0, a1 % 360.0
             msp.add_arc(
                 (float(centre[0]), float(centre[1])), float(pieces.r_start[k, j]), a0, a1, dxfattribs=attribs
             )
@@ -700,13 +708,18 @@ def _pitch_line(cam: Cam) -> FloatArray:
 def write_bar_dxfs(
     folder: str | os.PathLike[str], part: Part, *, fit: ProfileFit, plate: Plate, options: DxfSpec
 ) -> list[Path]:
-    """``profile{suffix}.dxf`` and ``profile_poly{suffix}.dxf`` of a linear cam's bar.
+    """``profile``, ``profile_poly`` and ``profile_arcs`` DXF files (with the part's suffix) of a bar.
 
     ``profile.dxf``: the edge as the fit's SPLINE and the bar's three sides
     as LINEs, head to tail on ``CAM_PROFILE`` (one closed outline), the
     pitch line dashed on ``PITCH_CURVE``, the annotation. ``profile_poly.dxf``:
     the whole outline as one closed LWPOLYLINE within ``[dxf] chord_tolerance``
     of the exact bar (the chord budget less the fit's certified error).
+    ``profile_arcs.dxf``: the open edge as tangent-continuous ARCs within the
+    fit tolerance of the exact edge, as a plate's profile
+    (:func:`~camcad.export._outline.arc_outline` on φ ∈ [0, 2π], from the
+    edge's exact start to its exact end), then the three sides as LINEs from
+    the edge's end back to its start: one closed outline on ``CAM_PROFILE``.
     """
     bar = part.bar
     assert bar is not None  # the caller writes a bar's part here
@@ -751,4 +764,45 @@ def write_bar_dxfs(
     _add_closed_polyline(msp2, poly, "CAM_PROFILE")
     _frame(doc2, (float(lo[0]), float(lo[1]), float(poly[:, 0].max()), float(poly[:, 1].max())))
     atomic_write(paths[1], lambda tmp: save_reproducible(_audited(doc2, "profile_poly.dxf"), tmp))
+
+    doc3, msp3 = _new_document()
+    _add_arcs(msp3, _bar_edge_arcs(cam, fit.tolerance), "CAM_PROFILE", positive_angles=True)
+    ends = cam.profile(np.array([2.0 * math.pi, 0.0])).point  # where the arcs end and start: on the edge
+    corners = [ends[0], (ends[0][0], bar.bottom), (ends[1][0], bar.bottom), ends[1]]
+    for a, b in itertools.pairwise(corners):
+        msp3.add_line(
+            (float(a[0]), float(a[1])), (float(b[0]), float(b[1])), dxfattribs={"layer": "CAM_PROFILE"}
+        )
+    pad = fit.tolerance + fit.max_error  # the arcs lie within the tolerance of the exact edge
+    _frame(
+        doc3,
+        (
+            float(lo[0]) - pad,
+            float(lo[1]) - pad,
+            float(poly[:, 0].max()) + pad,
+            float(poly[:, 1].max()) + pad,
+        ),
+    )
+    paths.append(Path(folder) / f"profile_arcs{part.suffix}.dxf")
+    atomic_write(paths[2], lambda tmp: save_reproducible(_audited(doc3, "profile_arcs.dxf"), tmp))
     return paths
+
+
+def _bar_edge_arcs(cam: Cam, tolerance: float) -> Pieces:
+    """The bar's open edge ``cam.offset_curve(φ, 0)``, φ ∈ [0, 2π], as biarcs within ``tolerance`` [mm].
+
+    Raises
+    ------
+    ExportError
+        When the edge has a corner (a velocity jump, refused earlier as a hard limit).
+    """
+
+    def exact(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        o = cam.offset_curve(phi, 0.0)
+        return o.point, o.d1, o.d2
+
+    try:
+        pieces, _ = arc_outline(exact, list(cam.program.pieces), tolerance)
+    except ValueError as err:
+        raise ExportError(f"profile_arcs.dxf: {err}") from err
+    return pieces

@@ -4,86 +4,47 @@ The bar's blank is squared beforehand; the program mills its top edge, the
 cam, through the bar's thickness: roughing passes at the tool radius plus
 the stock to leave, one per ``step_down`` level, then one finishing pass at
 the tool radius, each along the exact offset curve ``cam.offset_curve(φ, r)`` from
-one end of the bar to the other, entering and leaving along the edge's end
-tangents outside the bar. Climb milling (the material on the tool's left
-with a clockwise spindle) runs from the end x0 + L to the start x0,
-conventional the other way.
+one end of the bar to the other, entering and leaving outside the bar on
+straight G1 leads along the path's own end tangents.
 
-The offset curve is written as G1 chords chosen greedily on a dense exact
-sampling so that no sample lies farther than the tolerance from its chord;
-the deviation reported is measured the same way, after rounding to the
-written 4 decimals.
+Direction, by the plate's rule (:mod:`camcad.toolpath.plan`: M3 turns the
+spindle clockwise seen from +Z, and climb milling has the part on the tool's
+right, G41): the bar lies below the path, so climb runs towards +x, from
+x0 to x0 + L, and conventional the other way.
+
+The offset curve is an arc spline as on a plate (:func:`~camcad.toolpath.contour.fit_open_path`:
+the layered arc search of :mod:`camcad.toolpath.arcs` on the open curve,
+from the curve's start on its tangent to its end), fitted within the
+plate's band (``_fit_tolerance`` of :mod:`camcad.toolpath.plan`), rounded to the
+written 4 decimals with each arc's I/J from its rounded start, and measured
+two-way against the exact curve after rounding; the roughing path is the
+finishing arc spline offset by the stock, measured the same way.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 
 import numpy as np
 
-from camcad._typing import FloatArray
 from camcad.angles import TWO_PI
 from camcad.geometry.cam import Cam
 from camcad.geometry.families import Bar
 from camcad.geometry.tool import check_tool
 from camcad.knobs import Knob
+from camcad.toolpath.contour import OpenPath, fit_open_path, offset_open_path, round_mm, round_point
 from camcad.toolpath.passes import Program
-from camcad.toolpath.plan import Toolpath
+from camcad.toolpath.plan import Toolpath, _fit_tolerance
 from camcad.toolpath.spec import Direction, GcodeSpec
 
-__all__ = ["DENSE_SAMPLES", "chord_path", "plan_bar"]
+__all__ = ["plan_bar"]
 
-DENSE_SAMPLES = 20_001
-"""Exact samples of the offset curve per cycle the chords are chosen on (and measured against)."""
-_DECIMALS = 4  # the writer's coordinate digits
+_NO_REFIT = "the fewest-arcs refit thins closed contours only: the edge keeps the search's arcs"
 
 
-def _deviation(points: FloatArray, a: FloatArray, b: FloatArray) -> float:
-    """The largest distance of ``points`` (n, 2) from the segment a–b [mm]."""
-    d = b - a
-    length2 = float(d @ d)
-    t = np.clip(((points - a) @ d) / length2, 0.0, 1.0) if length2 > 0.0 else np.zeros(len(points))
-    near = a + t[:, None] * d
-    return float(np.max(np.hypot(*(points - near).T))) if len(points) else 0.0
-
-
-def chord_path(points: FloatArray, tolerance: float) -> tuple[FloatArray, float]:
-    """Vertices (m, 2) of a polyline through ``points``' ends within ``tolerance`` of all of them [mm].
-
-    Greedy: from each vertex, the farthest sample whose chord keeps every
-    sample in between within ``tolerance`` (found by doubling, then
-    bisection). Returns the vertices rounded to the written decimals and
-    the largest distance of any sample from the rounded polyline.
-    """
-    n = len(points)
-    keep = [0]
-    i = 0
-    while i < n - 1:
-
-        def fits(j: int, i: int = i) -> bool:
-            return _deviation(points[i + 1 : j], points[i], points[j]) <= tolerance
-
-        step = 1
-        while i + 2 * step < n and fits(i + 2 * step):
-            step *= 2
-        lo, hi = i + step, min(n - 1, i + 2 * step)  # lo fits; hi may not
-        if fits(hi):
-            lo = hi
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            lo, hi = (mid, hi) if fits(mid) else (lo, mid)
-        keep.append(lo)
-        i = lo
-    vertices = np.round(points[keep], _DECIMALS)
-    worst = max(
-        _deviation(points[a : b + 1], vertices[k], vertices[k + 1])
-        for k, (a, b) in enumerate(itertools.pairwise(keep))
-    )
-    return vertices, worst
-
-
-def plan_bar(cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float) -> Toolpath:
+def plan_bar(
+    cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float, arcs: bool = True
+) -> Toolpath:
     """Plan the roughing and finishing passes along a linear cam's edge.
 
     Parameters
@@ -98,12 +59,17 @@ def plan_bar(cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float
         The program's name.
     thickness
         The bar's thickness [mm]; the cut goes to −(thickness + breakthrough).
+    arcs
+        False writes the passes as G1 chords only, at the same tolerance
+        (for comparison).
 
     Raises
     ------
     GougeError
         Where a concave radius of the edge is smaller than the tool radius
         (:func:`camcad.geometry.tool.check_tool`).
+    DesignError
+        When the tolerance is finer than 4-decimal output holds.
     """
     r = spec.tool_radius
     concave = check_tool(cam, r)
@@ -112,41 +78,45 @@ def plan_bar(cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float
         if math.isfinite(concave)
         else spec.stock_to_leave
     )
-    phi = np.linspace(0.0, TWO_PI, DENSE_SAMPLES)
-    climb = spec.direction is Direction.CLIMB
+    fit_tol = _fit_tolerance(spec.tolerance)
+    breaks = np.array([0.0, TWO_PI])  # the edge's ends; a corner (a velocity jump) is refused earlier
     lead = r + spec.tool_diameter  # the tool enters and leaves this far beyond the bar's ends [mm]
-
-    def contour(distance: float) -> tuple[FloatArray, float, FloatArray, FloatArray]:
-        curve = cam.offset_curve(phi, distance)
-        pts = np.asarray(curve.point, dtype=float)
-        path, worst = chord_path(pts[::-1] if climb else pts, spec.tolerance)
-        ends = curve.tangent[[-1, 0]] if climb else curve.tangent[[0, -1]]
-        sense = -1.0 if climb else 1.0  # the path runs against the curve's direction when climbing
-        return path, worst, sense * ends[0], sense * ends[1]
+    reverse = spec.direction is not Direction.CLIMB  # climb runs towards +x, with increasing φ
+    finish = fit_open_path(cam, r, breaks, spec.tolerance, fit_tol, reverse=reverse, arcs=arcs)
+    if stock <= 0.0:
+        rough = finish
+    elif (
+        arcs
+    ):  # the finishing arc spline offset by the stock (arcs stay arcs), measured; refitted if it misses
+        rough = offset_open_path(cam, finish, r + stock, breaks, spec.tolerance, fit_tol)
+    else:  # chords offset apart at their corners: fit them afresh
+        rough = fit_open_path(cam, r + stock, breaks, spec.tolerance, fit_tol, reverse=reverse, arcs=False)
 
     depth = thickness + spec.breakthrough
     n_levels = max(1, math.ceil(depth / spec.step_down - 1e-9))
-    levels = tuple(round(-depth * k / n_levels, _DECIMALS) for k in range(1, n_levels + 1))
+    levels = tuple(round_mm(-depth * k / n_levels) for k in range(1, n_levels + 1))
     prog = Program(spec.clearance_height)
-    rough, _, t_in, t_out = contour(r + stock)
-    finish, deviation, f_in, f_out = contour(r)
 
-    def cut(path: FloatArray, t_in: FloatArray, t_out: FloatArray, z: float, text: str) -> None:
-        start = np.round(path[0] - lead * t_in, _DECIMALS)
-        end = np.round(path[-1] + lead * t_out, _DECIMALS)
+    def cut(path: OpenPath, z: float, text: str) -> None:
+        t_in, t_out = path.start_tangent, path.end_tangent
+        start = round_point((path.start[0] - lead * t_in[0], path.start[1] - lead * t_in[1]))
+        end = round_point((path.end[0] + lead * t_out[0], path.end[1] + lead * t_out[1]))
         prog.rapid(z=spec.clearance_height)
-        prog.rapid(x=float(start[0]), y=float(start[1]))
+        prog.rapid(*start)
         prog.rapid(z=spec.safe_height)
         prog.comment(text)
         prog.line(z=z, feed=spec.plunge_feed)
-        for x, y in (*path, end):
-            prog.line(x=float(x), y=float(y), feed=spec.feed)
+        prog.line(*path.start, feed=spec.feed)  # the lead in, along the path's start tangent
+        for st in path.steps:
+            if st.center is None:
+                prog.line(*st.end, feed=spec.feed)
+            else:
+                prog.arc(st.kind, *st.end, st.center, feed=spec.feed)
+        prog.line(*end, feed=spec.feed)  # the lead out, along its end tangent
 
     for k, z in enumerate(levels, start=1):
-        cut(
-            rough, t_in, t_out, z, f"edge roughing pass {k}/{n_levels} at Z{z:.4f}, offset {r + stock:.4f} mm"
-        )
-    cut(finish, f_in, f_out, levels[-1], f"edge finishing pass at Z{levels[-1]:.4f}, offset {r:.4f} mm")
+        cut(rough, z, f"edge roughing pass {k}/{n_levels} at Z{z:.4f}, offset {r + stock:.4f} mm")
+    cut(finish, levels[-1], f"edge finishing pass at Z{levels[-1]:.4f}, offset {r:.4f} mm")
     prog.rapid(z=spec.clearance_height)
     x1 = bar.x0 + bar.length
     return Toolpath(
@@ -159,12 +129,13 @@ def plan_bar(cam: Cam, bar: Bar, spec: GcodeSpec, *, name: str, thickness: float
         final_depth=levels[-1],
         tab_top=None,
         rough_offset=r + stock,
-        max_deviation=deviation,
-        contour_blocks=len(finish) - 1,
-        contour_arcs=len(finish) - 1,
+        max_deviation=finish.max_deviation,
+        contour_blocks=len(finish.steps),
+        contour_arcs=len(finish.steps),  # no tabs split a bar's steps
         notes=(
             f"linear cam bar: open edge cut from X{bar.x0:.4f} to X{x1:.4f}, bottom at Y{bar.bottom:.4f}; "
             "the blank is squared beforehand",
             *([f"no tabs on a bar edge ({spec.name_of(Knob.TAB_COUNT)} ignored)"] if spec.tab_count else []),
+            *([_NO_REFIT] if spec.fewest_arcs and arcs else []),
         ),
     )

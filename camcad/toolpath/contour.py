@@ -25,10 +25,13 @@ __all__ = [
     "DECIMALS",
     "LINE_SAGITTA",
     "Contour",
+    "OpenPath",
     "Step",
     "fit_contour",
+    "fit_open_path",
     "offset_contour",
     "offset_curve",
+    "offset_open_path",
     "round_mm",
     "round_point",
     "split_tabs",
@@ -98,8 +101,12 @@ def _signed_area(pieces: Pieces) -> float:
     return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
 
 
-def _emit(pieces: Pieces, *, reverse: bool, tol: float) -> tuple[list[Step], Pieces]:
-    """Round the pieces into steps in travel order; also return them as realised, in φ order."""
+def _emit(pieces: Pieces, *, reverse: bool, tol: float, closed: bool = True) -> tuple[list[Step], Pieces]:
+    """Round the pieces into steps in travel order; also return them as realised, in φ order.
+
+    A closed contour's last step ends on its (rounded) start; an open path's
+    on its own rounded end.
+    """
     n = len(pieces)
     order = [(i, k) for i in range(n) for k in (0, 1)]
     if reverse:
@@ -113,7 +120,7 @@ def _emit(pieces: Pieces, *, reverse: bool, tol: float) -> tuple[list[Step], Pie
     steps: list[Step] = []
     for idx, (i, k) in enumerate(order):
         far = pieces.start[i, k] if reverse else pieces.end[i, k]
-        e = origin if idx == len(order) - 1 else round_point(far)
+        e = origin if closed and idx == len(order) - 1 else round_point(far)
         sag = 0.0 if pieces.line[i, k] else pieces.r_start[i, k] * (1.0 - math.cos(0.5 * sweep[i, k]))
         ctr = None
         if cur == e:
@@ -360,3 +367,102 @@ def _end_tangents(pieces: Pieces) -> tuple[FloatArray, FloatArray]:
     last = len(pieces) - 1
     null = bool(pieces.line[last, 1] and np.all(pieces.start[last, 1] == pieces.end[last, 1]))
     return starts[0, 0], ends[last, 0 if null else 1]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class OpenPath:
+    """An open path in travel order, rounded: from ``steps[0].start`` to ``steps[-1].end``.
+
+    The open counterpart of :class:`Contour` (a linear cam's edge,
+    :func:`camcad.toolpath.bar.plan_bar`): its ends lie on the exact curve's
+    ends (rounded); its end tangents are the arc spline's own there.
+    """
+
+    steps: tuple[Step, ...]
+    max_deviation: float  # mm, measured after rounding
+    start_tangent: tuple[float, float]  # unit, travel direction
+    end_tangent: tuple[float, float]
+    distance: float  # mm: the offset from the profile this path follows
+    pieces: Pieces  # the fitted pieces before rounding, in φ order
+    reverse: bool  # travels against increasing φ
+
+    @property
+    def start(self) -> tuple[float, float]:
+        """Where the path starts [mm] (rounded)."""
+        return self.steps[0].start
+
+    @property
+    def end(self) -> tuple[float, float]:
+        """Where the path ends [mm] (rounded)."""
+        return self.steps[-1].end
+
+
+def fit_open_path(
+    cam: Cam,
+    distance: float,
+    breaks: FloatArray,
+    tol: float,
+    fit_tol: float,
+    *,
+    reverse: bool,
+    arcs: bool = True,
+) -> OpenPath:
+    """Fit, orient, round and measure the open path ``cam.offset_curve(phi, distance)`` over ``breaks``.
+
+    The arc spline (:func:`~camcad.toolpath.arcs.spline.fit_arc_spline`, not
+    closed) starts on the exact curve at ``breaks[0]`` with its tangent and
+    ends on it at ``breaks[-1]`` (by a biarc on its tangent, or an arc that
+    lands there, its tangent within the band's); every break in between is
+    a node on the curve. The path's end tangents are its own. ``reverse``
+    travels from the last break to the first. ``tol`` and ``fit_tol`` [mm]
+    as for :func:`fit_contour`: the deviation is measured after rounding,
+    two-way, and must be within ``tol``. ``arcs`` False writes G1 chords
+    only (for comparison).
+    """
+    curve = offset_curve(cam, distance)
+    try:
+        pieces, _ = fit_arc_spline(curve, breaks, fit_tol, arcs=arcs, closed=False)
+    except ValueError as err:  # pragma: no cover - only for a cusp the gouge check missed
+        raise DesignLimitError(f"cannot fit the toolpath: {err}") from err
+    return _realise_open(curve, distance, pieces, tol, reverse=reverse)
+
+
+def offset_open_path(
+    cam: Cam, base: OpenPath, distance: float, breaks: FloatArray, tol: float, fit_tol: float
+) -> OpenPath:
+    """The open path ``cam.offset_curve(phi, distance)`` as the offset of another path's arc spline.
+
+    As :func:`offset_contour` for a closed contour: ``base``'s pieces offset
+    by ``distance − base.distance`` (arcs stay arcs), measured two-way
+    against the exact curve and used where within ``fit_tol``; otherwise
+    the curve is fitted afresh (:func:`fit_open_path`). The travel direction
+    is ``base``'s.
+    """
+    curve = offset_curve(cam, distance)
+    at = cam.offset_curve(np.array([breaks[0]]), base.distance)
+    left = float(np.sign(cross(at.tangent[0], at.normal[0])))  # +1: outward is left of increasing φ
+    moved = offset_pieces(base.pieces, left * (distance - base.distance))
+    if moved is not None and float(measure_deviation(curve, moved).max()) <= fit_tol:
+        return _realise_open(curve, distance, moved, tol, reverse=base.reverse)
+    return fit_open_path(cam, distance, breaks, tol, fit_tol, reverse=base.reverse)
+
+
+def _realise_open(curve: CurveFn, distance: float, pieces: Pieces, tol: float, *, reverse: bool) -> OpenPath:
+    """Round, measure and merge the pieces of an open path into steps in travel order."""
+    steps, real = _emit(pieces, reverse=reverse, tol=tol, closed=False)
+    dev = float(measure_deviation(curve, real, samples=48).max())
+    if dev > tol:  # pragma: no cover - the fit keeps a margin for rounding
+        raise DesignLimitError(f"toolpath deviation {dev:.5f} mm exceeds the tolerance {tol:g} mm")
+    starts, ends = pieces.tangents()
+    live = np.flatnonzero(pieces.length().reshape(-1) > 0.0)  # a null piece has no tangent
+    t_lo, t_hi = starts.reshape(-1, 2)[live[0]], ends.reshape(-1, 2)[live[-1]]
+    t_start, t_end = (-t_hi, -t_lo) if reverse else (t_lo, t_hi)
+    return OpenPath(
+        steps=tuple(_merge(steps)),
+        max_deviation=dev,
+        start_tangent=(float(t_start[0]), float(t_start[1])),
+        end_tangent=(float(t_end[0]), float(t_end[1])),
+        distance=distance,
+        pieces=pieces,
+        reverse=reverse,
+    )

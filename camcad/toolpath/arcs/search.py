@@ -367,10 +367,11 @@ def _circles(pts: FloatArray, d1: FloatArray, d2: FloatArray) -> _Circles:
     """The runs of at least ``_CIRCLE_RUN`` samples on one circle (centre and radius equal to 1e-6 mm)."""
     speed = np.linalg.norm(d1, axis=1)
     kappa = cross(d1, d2) / speed**3
-    with np.errstate(divide="ignore"):
+    # a straight stretch (a linear cam's dwell) has κ = 0: an infinite radius, no centre, no circle
+    with np.errstate(divide="ignore", invalid="ignore"):
         rho = 1.0 / kappa
-    center = pts + rho[:, None] * left_normal(d1 / speed[:, None])
-    same = (np.abs(np.diff(rho)) <= _CIRCLE_SAME) & (norm2(np.diff(center, axis=0)) <= _CIRCLE_SAME)
+        center = pts + rho[:, None] * left_normal(d1 / speed[:, None])
+        same = (np.abs(np.diff(rho)) <= _CIRCLE_SAME) & (norm2(np.diff(center, axis=0)) <= _CIRCLE_SAME)
     same &= np.isfinite(rho[1:]) & (np.abs(rho[1:]) < _CIRCLE_LARGEST)
     edges = np.flatnonzero(np.diff(np.concatenate(([0], same.astype(int), [0]))))
     first, last = edges[::2], edges[1::2]  # run k: samples first[k] … last[k]

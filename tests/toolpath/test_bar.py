@@ -1,0 +1,130 @@
+"""Arc splines on an open curve, and a linear cam's bar milled in arcs (issue 36).
+
+- The law, over open curves (hypothesis): the arc spline of an open curve
+  starts on C(a) with the curve's tangent, ends on C(b) (with its tangent,
+  or an arc landing there within the band), joins G1, and lies within the
+  tolerance of the curve both ways by a brute force independent of the
+  fit's measurement (dense samples of both).
+- The bar's plan (:func:`camcad.toolpath.bar.plan_bar`): its written
+  finishing pass, rounded to 4 decimals, is within the plate's band of the
+  exact offset both ways by brute force, which the reported
+  ``max_deviation`` bounds; climb runs with the part on the tool's right
+  (towards +x); G1 chords at the same tolerance need several times the blocks.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from functools import cache
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+
+from camcad.design import load_design
+from camcad.geometry.cam import Cam
+from camcad.geometry.families import Bar, family_of
+from camcad.toolpath.arcs.spline import fit_arc_spline
+from camcad.toolpath.bar import plan_bar
+from camcad.toolpath.spec import Direction
+from camcad.toolpath.verify import densify
+from tests.conftest import ROOT
+from tests.readers.test_rs274_linear import passes
+from tests.toolpath.test_arcs import assert_two_way_within, dense_distance
+
+
+def graph(length: float, amp: float, k: int, slope: float):
+    """The open curve x = cφ, y = amp·sin(kφ) + slope·cφ (c = length/2π), φ ∈ [0, 2π], and derivatives."""
+    c = length / (2.0 * math.pi)
+
+    def curve(phi):
+        phi = np.asarray(phi, dtype=float)
+        p = np.column_stack((c * phi, amp * np.sin(k * phi) + slope * c * phi))
+        d1 = np.column_stack((np.full_like(phi, c), amp * k * np.cos(k * phi) + slope * c))
+        d2 = np.column_stack((np.zeros_like(phi), -amp * k * k * np.sin(k * phi)))
+        return p, d1, d2
+
+    return curve
+
+
+@settings(max_examples=8, deadline=None)
+@given(
+    length=st.floats(80.0, 400.0),
+    amp=st.floats(0.0, 15.0),
+    k=st.integers(1, 3),
+    slope=st.floats(-0.5, 0.5),
+    tol=st.sampled_from([0.002, 0.01]),
+)
+def test_an_open_curve_s_arc_spline_runs_end_to_end_g1_within_tolerance(length, amp, k, slope, tol):
+    curve = graph(length, amp, k, slope)
+    pieces, dev = fit_arc_spline(curve, np.array([0.0, 2.0 * math.pi]), tol, closed=False)
+    assert dev.max() <= tol
+    ends, d1, _ = curve(np.array([0.0, 2.0 * math.pi]))
+    tangent = d1 / np.linalg.norm(d1, axis=1)[:, None]
+    starts, stops = pieces.tangents()
+    assert_allclose(pieces.start[0, 0], ends[0], atol=1e-12)
+    assert_allclose(starts[0, 0], tangent[0], atol=1e-9)
+    # it ends on the curve's end: by a biarc on the curve's tangent, or an arc that lands there (its
+    # tangent then within the band's slack of the curve's)
+    last = len(pieces) - 1
+    k_end = 0 if np.all(pieces.start[last, 1] == pieces.end[last, 1]) else 1
+    assert_allclose(pieces.end[last, k_end], ends[1], atol=1e-9)
+    assert float(stops[last, k_end] @ tangent[1]) > math.cos(0.01)
+    # G1: every piece starts where the one before ends, on its tangent
+    flat_start, flat_end = pieces.start.reshape(-1, 2), pieces.end.reshape(-1, 2)
+    live = np.linalg.norm(flat_end - flat_start, axis=1) > 0.0
+    t0, t1 = starts.reshape(-1, 2)[live], stops.reshape(-1, 2)[live]
+    assert_allclose(flat_end[live][:-1], flat_start[live][1:], atol=1e-9)
+    assert_allclose(t1[:-1], t0[1:], atol=1e-7)
+    assert_two_way_within(curve, pieces, tol)
+
+
+@cache
+def bar_case() -> tuple[Cam, Bar, object]:
+    design = load_design(ROOT / "samples" / "linear_cam.toml")
+    (part,) = family_of(design.cam.style).parts(Cam.from_design(design), design.family_options())
+    assert part.bar is not None
+    return part.cam, part.bar, design
+
+
+@pytest.mark.parametrize("direction", ["climb", "conventional"])
+def test_the_bar_s_written_finishing_pass_is_within_the_band_and_its_certificate(direction):
+    cam, bar, design = bar_case()
+    spec = replace(design.gcode, direction=Direction(direction))
+    tp = plan_bar(cam, bar, spec, name="bar", thickness=design.cam.thickness)
+    finish = passes(list(tp.moves))[-1]
+    assert finish[0].end[2] == tp.final_depth
+    cut = finish[1:-1]  # the leads: straight, on along the end tangents
+    assert len(cut) == tp.contour_blocks
+    assert not finish[0].kind.is_arc and not finish[-1].kind.is_arc
+    assert sum(m.kind.is_arc for m in cut) >= 0.8 * len(cut)
+    r = spec.tool_radius
+    exact = np.asarray(cam.offset_curve(np.linspace(0.0, 2.0 * math.pi, 40_001), r).point)
+    written = np.vstack([densify(m, 0.005)[:, :2] for m in cut])
+    brute = max(dense_distance(written, exact).max(), dense_distance(exact[::4], written).max())
+    assert brute <= tp.max_deviation + 1e-6 <= spec.tolerance + 1e-6
+    # climb: the part (below the edge) on the tool's right, so the tool travels towards +x
+    assert (cut[-1].end[0] > cut[0].start[0]) == (direction == "climb")
+
+
+def test_g1_chords_of_the_bar_need_several_times_the_blocks_of_its_arcs():
+    cam, bar, design = bar_case()
+    arcs = plan_bar(cam, bar, design.gcode, name="bar", thickness=design.cam.thickness)
+    chords = plan_bar(cam, bar, design.gcode, name="bar", thickness=design.cam.thickness, arcs=False)
+    assert chords.max_deviation <= design.gcode.tolerance
+    assert all(not m.kind.is_arc for m in chords.moves)
+    assert chords.contour_blocks >= 3 * arcs.contour_blocks
+
+
+def test_the_fewest_arcs_refit_leaves_an_open_edge_as_searched_and_says_so():
+    cam, bar, design = bar_case()
+    plain = plan_bar(cam, bar, design.gcode, name="bar", thickness=design.cam.thickness)
+    asked = plan_bar(
+        cam, bar, replace(design.gcode, fewest_arcs=True), name="bar", thickness=design.cam.thickness
+    )
+    assert asked.moves == plain.moves
+    assert any("fewest-arcs" in note for note in asked.notes)
+    assert not any("fewest-arcs" in note for note in plain.notes)
