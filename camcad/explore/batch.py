@@ -484,7 +484,7 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
 def _duty_answers(
     group: _Group, setups: Sequence[Any], grid_state: CamState, grid_phi: FloatArray, joints: FloatArray
 ) -> list[list[Answer]]:
-    """The answers of every variant's exact film and track searches (:func:`camcad.dynamics.duty.analyse_duty`).
+    """The answers of each variant's film and track searches (:func:`~camcad.dynamics.duty.analyse_duty`).
 
     The lubricant film's smallest ratio λ and the track's largest load-stress
     factor are searched on the exact cam as the geometry's and the dynamics'
