@@ -81,6 +81,7 @@ _XSTOP = 1e-9  # rad: a parabolic step this small has converged (the value's err
 # Where a piece's first and last sample gaps are probed, as fractions of the gap (see _probe_end_gaps):
 # next to both ends, which catches a peak right beside a joint, and at eighths.
 _END_PROBES = np.array([1e-3, *(np.arange(1, 8) / 8), 1.0 - 1e-3])
+_ROW_BLOCK = 64  # rows whose samples are scanned together (see _extremes)
 
 
 def side_text(side: Side | None) -> str:
@@ -152,27 +153,59 @@ def _rows(values: ArrayLike, k: int) -> FloatArray:
     return out.reshape(k, -1)
 
 
-def _sequence(
+@dataclass(frozen=True, slots=True)
+class _Layout:
+    """Where each row's samples go in its :class:`_Sequence`: the grid's right values, then the extra columns.
+
+    ``right`` (k, n) are the values on the grid, ``extra`` (k, j) the right
+    values at joints off the grid and the left limits at the joints; ``order``
+    (n + j,) sorts their columns into the sequence.
+    """
+
+    phi: FloatArray
+    piece: np.ndarray
+    left: np.ndarray
+    order: np.ndarray
+    right: FloatArray
+    extra: FloatArray
+
+    def rows(self, lo: int, hi: int) -> _Sequence:
+        """The sequence of rows lo … hi − 1."""
+        value = np.take(np.concatenate((self.right[lo:hi], self.extra[lo:hi]), axis=1), self.order, axis=1)
+        return _Sequence(phi=self.phi, value=value, piece=self.piece, left=self.left)
+
+
+def _layout(
     quantity: Rows, grid: FloatArray, joints: FloatArray, values: FloatArray | None, k: int
-) -> _Sequence:
+) -> _Layout:
     bounds = np.union1d(np.mod(joints, TWO_PI), [0.0])
     right = _rows(quantity(grid, "right") if values is None else values, k)
     missing = bounds[~np.isin(bounds, grid)]
+    extra = []
     if missing.size:  # a joint off the grid: add its right value too
         grid = np.concatenate((grid, missing))
-        right = np.concatenate((right, _rows(quantity(missing, "right"), k)), axis=1)
+        extra.append(_rows(quantity(missing, "right"), k))
     left_phi = np.where(bounds == 0.0, TWO_PI, bounds)
-    left = _rows(quantity(left_phi, "left"), k)
+    extra.append(_rows(quantity(left_phi, "left"), k))
     piece_grid = np.searchsorted(bounds, grid, side="right") - 1
     piece_left = np.searchsorted(bounds, left_phi, side="left") - 1  # the piece that ends there
     phi = np.concatenate((grid, left_phi))
     order = np.lexsort((phi, np.concatenate((piece_grid, piece_left))))
-    return _Sequence(
+    return _Layout(
         phi=phi[order],
-        value=np.take(np.concatenate((right, left), axis=1), order, axis=1),
         piece=np.concatenate((piece_grid, piece_left))[order],
         left=np.concatenate((np.zeros(grid.size, bool), np.ones(left_phi.size, bool)))[order],
+        order=order,
+        right=right,
+        extra=np.concatenate(extra, axis=1),
     )
+
+
+def _sequence(
+    quantity: Rows, grid: FloatArray, joints: FloatArray, values: FloatArray | None, k: int
+) -> _Sequence:
+    """The samples of every row in one sequence (right values on the grid, left limits at the joints)."""
+    return _layout(quantity, grid, joints, values, k).rows(0, k)
 
 
 @dataclass(frozen=True, slots=True)
@@ -261,6 +294,10 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
     return _Brackets(
         np.concatenate(out_rows), joined(x1), joined(x2), joined(x3), joined(f1), joined(f2), joined(f3)
     )
+
+
+def _fields(b: _Brackets) -> tuple[np.ndarray, ...]:
+    return (b.row, b.x1, b.x2, b.x3, b.f1, b.f2, b.f3)
 
 
 def _without_rests(b: _Brackets, rests: Sequence[tuple[float, float]]) -> _Brackets:
@@ -490,7 +527,7 @@ def _extremes(
             return got
     k = len(kinds)
     grid_a = np.asarray(grid, dtype=float)
-    seq = _sequence(
+    layout = _layout(
         quantity,
         grid_a,
         np.asarray(joints, dtype=float).ravel(),
@@ -498,19 +535,35 @@ def _extremes(
         k,
     )
     sign = np.array([1.0 if kind == "max" else -1.0 for kind in kinds])[:, None]
-    val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
-    top = np.argmax(val, axis=1)
-    best = val[np.arange(k), top]
+    best = np.empty(k)
+    found: list[Extreme] = []
     twins: dict[int, int] = {}
-    found = [
-        Extreme(
-            value=float(seq.value[r, top[r]]),
-            phi=float(seq.phi[top[r]]),
-            side=_sample_side(seq, r, int(top[r]), twins),
-        )
-        for r in range(k)
-    ]
-    br = _without_rests(_brackets(seq, val, best), rests)
+    parts: list[_Brackets] = []
+    # the samples' extremes and the brackets, _ROW_BLOCK rows at a time (each row's alone: a block's
+    # arrays stay in the processor's cache when a batch stacks the rows of many analyses)
+    for lo in range(0, k, _ROW_BLOCK):
+        hi = min(k, lo + _ROW_BLOCK)
+        seq = layout.rows(lo, hi)
+        sg = sign[lo:hi]
+        val = sg * np.where(np.isnan(seq.value), -sg * np.inf, seq.value)
+        top = np.argmax(val, axis=1)
+        best[lo:hi] = val[np.arange(hi - lo), top]
+        found += [
+            Extreme(
+                value=float(seq.value[r, top[r]]),
+                phi=float(seq.phi[top[r]]),
+                side=_sample_side(seq, r, int(top[r]), twins),
+            )
+            for r in range(hi - lo)
+        ]
+        got = _brackets(seq, val, best[lo:hi])
+        parts.append(_Brackets(got.row + lo, got.x1, got.x2, got.x3, got.f1, got.f2, got.f3))
+    br = (
+        parts[0]
+        if len(parts) == 1
+        else _Brackets(*(np.concatenate(f) for f in zip(*(_fields(b) for b in parts), strict=True)))
+    )
+    br = _without_rests(br, rests)
     if any(settled):
         searched: np.ndarray = np.logical_not(np.asarray(settled, dtype=bool))[br.row]
         br = _select(br, searched)

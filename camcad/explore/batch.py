@@ -349,6 +349,35 @@ def _state_take(state: CamState, index: np.ndarray | slice) -> CamState:
     )
 
 
+_GRID_BLOCK = 8
+"""Variants whose grid state and rows are evaluated together (in blocks: their arrays stay in cache)."""
+
+
+@dataclass(frozen=True, slots=True)
+class _Block:
+    """Variants first … first + count − 1 on their stacked grid: its angles, their variant, the state."""
+
+    first: int
+    count: int
+    phi: FloatArray
+    which: np.ndarray
+    state: CamState
+
+
+def _by_variant(values: FloatArray, k: int, nv: int, m: int) -> FloatArray:
+    """(k, V·m) k rows at the angles of V variants in turn → (V·k, m), variant after variant."""
+    out: FloatArray = values.reshape(k, nv, m).transpose(1, 0, 2).reshape(nv * k, m)
+    return out
+
+
+def _block_rows(blocks: Sequence[_Block], rows: Any, k: int, nv: int, n: int) -> FloatArray:
+    """(V·k, n) the k grid rows of every variant, variant after variant, ``rows(block)`` (k, count·n) each."""
+    out = np.empty((nv * k, n))
+    for b in blocks:
+        out[b.first * k : (b.first + b.count) * k] = _by_variant(rows(b), k, b.count, n)
+    return out
+
+
 Answer = tuple[
     FloatArray,
     FloatArray,
@@ -373,14 +402,23 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
     loop = cast(Cam, _Loop(group.pitch))
     joints = np.array([bp.phi for bp in group.cams[0].program.breakpoints], dtype=float)
     rests = group.cams[0].rests
-    every = np.repeat(np.arange(nv), n)
-    tiled = _tile(group.grid_motion, nv)
-    for sigma in (group.sigma, -group.sigma):  # the grid's turn, once for all the variants
-        keep_turn(
-            tiled.phi, sigma, np.tile(np.cos(sigma * group.phi), nv), np.tile(np.sin(sigma * group.phi), nv)
+    # the grid state of _GRID_BLOCK variants at a time (arrays that stay in the processor's cache), each
+    # block's stacked grid one tiled motion, turned by the grid's own cos and sin
+    turn = {
+        sigma: (np.cos(sigma * group.phi), np.sin(sigma * group.phi)) for sigma in (group.sigma, -group.sigma)
+    }
+    tiles: dict[int, Motion] = {}
+    blocks: list[_Block] = []
+    for v0 in range(0, nv, _GRID_BLOCK):
+        count = min(_GRID_BLOCK, nv - v0)
+        tiled = tiles.setdefault(count, _tile(group.grid_motion, count))
+        for sigma, (cos, sin) in turn.items():
+            keep_turn(tiled.phi, sigma, np.tile(cos, count), np.tile(sin, count))
+        which = np.repeat(np.arange(v0, v0 + count), n)
+        blocks.append(
+            _Block(first=v0, count=count, phi=tiled.phi, which=which, state=group.state(tiled, which))
         )
-    stacked = group.state(tiled, every)
-    states = [_state_slice(stacked, v * n, (v + 1) * n) for v in range(nv)]
+    states = [_state_slice(b.state, i * n, (i + 1) * n) for b in blocks for i in range(b.count)]
 
     def stacked_at(p: FloatArray, which: np.ndarray, side: Side) -> CamState:
         return group.state(group.motion(p, side), which)
@@ -439,10 +477,9 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
 
     def by_variant(values: FloatArray, m: int) -> FloatArray:
         """(k, V·m) rows of the variants' angles in turn → (V·k, m), variant after variant."""
-        out: FloatArray = values.reshape(k, nv, m).transpose(1, 0, 2).reshape(nv * k, m)
-        return out
+        return _by_variant(values, k, nv, m)
 
-    values = by_variant(both(stacked, every), n)
+    values = _block_rows(blocks, lambda b: both(b.state, b.which), k, nv, n)
 
     def quantity(p: FloatArray, side: Side) -> FloatArray:
         m = p.size
@@ -476,13 +513,13 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
                 (group.phi, joints, kinds, values[mid:hi], rests, models[owner[v]][0][1][1], found[mid:hi]),
             ]
         )
-    for mine, more in zip(answers, _duty_answers(group, setups, stacked, tiled.phi, joints), strict=True):
+    for mine, more in zip(answers, _duty_answers(group, setups, blocks, joints), strict=True):
         mine += more
     return states, answers
 
 
 def _duty_answers(
-    group: _Group, setups: Sequence[Any], grid_state: CamState, grid_phi: FloatArray, joints: FloatArray
+    group: _Group, setups: Sequence[Any], blocks: Sequence[_Block], joints: FloatArray
 ) -> list[list[Answer]]:
     """The answers of each variant's film and track searches (:func:`~camcad.dynamics.duty.analyse_duty`).
 
@@ -571,18 +608,13 @@ def _duty_answers(
                 out[:, mine] = evaluate(p[mine], _state_take(st, mine), which[mine], side, at)
         return out
 
-    def by_variant(values: FloatArray, m: int) -> FloatArray:
-        out: FloatArray = values.reshape(kq, nv, m).transpose(1, 0, 2).reshape(nv * kq, m)
-        return out
-
-    every = np.repeat(np.arange(nv), n)
-    values = by_variant(rows(grid_phi, grid_state, every, "right"), n)
+    values = _block_rows(blocks, lambda b: rows(b.phi, b.state, b.which, "right"), kq, nv, n)
 
     def quantity(p: FloatArray, side: Side) -> FloatArray:
         m = p.size
         which = np.repeat(np.arange(nv), m)
         tiled = np.tile(p, nv)
-        return by_variant(rows(tiled, group.state(group.motion(tiled, side), which), which, side), m)
+        return _by_variant(rows(tiled, group.state(group.motion(tiled, side), which), which, side), kq, nv, m)
 
     def pick(p: FloatArray, which_rows: np.ndarray, side: Side) -> FloatArray:
         which = which_rows // kq
