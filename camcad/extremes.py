@@ -549,12 +549,13 @@ def _extremes(
         top = np.argmax(val, axis=1)
         best[lo:hi] = val[np.arange(hi - lo), top]
         found += [
-            Extreme(
-                value=float(seq.value[r, top[r]]),
-                phi=float(seq.phi[top[r]]),
-                side=_sample_side(seq, r, int(top[r]), twins),
+            Extreme(value=v, phi=f, side=side)
+            for v, f, side in zip(
+                seq.value[np.arange(hi - lo), top].tolist(),
+                seq.phi[top].tolist(),
+                _sample_sides(seq, top, twins),
+                strict=True,
             )
-            for r in range(hi - lo)
         ]
         got = _brackets(seq, val, best[lo:hi])
         parts.append(_Brackets(got.row + lo, got.x1, got.x2, got.x3, got.f1, got.f2, got.f3))
@@ -688,6 +689,24 @@ def _sample_side(seq: _Sequence, row: int, k: int, twins: dict[int, int] | None 
     return "right" if twin >= 0 and not _same(value[twin], value[k]) else None
 
 
+def _sample_sides(seq: _Sequence, top: np.ndarray, twins: dict[int, int]) -> list[Side | None]:
+    """:func:`_sample_side` of sample ``top[r]`` of every row r, all rows at once (the same rule)."""
+    for k in np.unique(top).tolist():
+        if k not in twins:
+            _sample_side(seq, 0, k, twins)  # finds and keeps the sample's twin
+    twin = np.array([twins[k] for k in top.tolist()], dtype=int)
+    rows = np.arange(top.size)
+    x = seq.value[rows, np.maximum(twin, 0)]
+    y = seq.value[rows, top]
+    with np.errstate(invalid="ignore"):  # _same, elementwise
+        same = (x == y) | (np.abs(x - y) <= _CONTINUOUS_RTOL * np.maximum(np.abs(x), np.abs(y)))
+    paired = twin >= 0
+    left = seq.left[top]
+    words: list[Side | None] = [None, "left", "right"]
+    code = np.where(left, np.where(paired & same, 0, 1), np.where(paired & ~same, 2, 0))
+    return [words[c] for c in code.tolist()]
+
+
 def _same(x: float, y: float) -> bool:
     """Whether two one-sided limits agree to round-off (the quantity is continuous there)."""
     return bool(x == y or abs(x - y) <= _CONTINUOUS_RTOL * max(abs(x), abs(y)))
@@ -739,7 +758,13 @@ class _Answers:
 
 def _same_bits(a: FloatArray, b: FloatArray) -> bool:
     """Whether two arrays hold the same numbers bit for bit (−0.0 is not 0.0, NaN is NaN)."""
-    return a.shape == b.shape and np.ascontiguousarray(a).tobytes() == np.ascontiguousarray(b).tobytes()
+    if a.shape != b.shape:
+        return False
+    if a.dtype == b.dtype == np.float64:  # the bits as integers, compared in place (no copies)
+        return bool(
+            np.array_equal(np.ascontiguousarray(a).view(np.int64), np.ascontiguousarray(b).view(np.int64))
+        )
+    return np.ascontiguousarray(a).tobytes() == np.ascontiguousarray(b).tobytes()
 
 
 _SERVED: ContextVar[_Answers | None] = ContextVar("camcad_extremes_served", default=None)

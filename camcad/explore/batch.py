@@ -372,10 +372,10 @@ def _by_variant(values: FloatArray, k: int, nv: int, m: int) -> FloatArray:
 
 def _block_rows(blocks: Sequence[_Block], rows: Any, k: int, nv: int, n: int) -> FloatArray:
     """(V·k, n) the k grid rows of every variant, variant after variant, ``rows(block)`` (k, count·n) each."""
-    out = np.empty((nv * k, n))
+    out = np.empty((nv, k, n))
     for b in blocks:
-        out[b.first * k : (b.first + b.count) * k] = _by_variant(rows(b), k, b.count, n)
-    return out
+        out[b.first : b.first + b.count] = np.reshape(rows(b), (k, b.count, n)).transpose(1, 0, 2)
+    return out.reshape(nv * k, n)
 
 
 Answer = tuple[
