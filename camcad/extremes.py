@@ -557,8 +557,8 @@ def _extremes(
                 strict=True,
             )
         ]
-        got = _brackets(seq, val, best[lo:hi])
-        parts.append(_Brackets(got.row + lo, got.x1, got.x2, got.x3, got.f1, got.f2, got.f3))
+        b = _brackets(seq, val, best[lo:hi])
+        parts.append(_Brackets(b.row + lo, b.x1, b.x2, b.x3, b.f1, b.f2, b.f3))
     br = (
         parts[0]
         if len(parts) == 1

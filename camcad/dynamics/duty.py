@@ -432,7 +432,7 @@ def carried_in_state(
 
 
 def film_ratio_of(
-    carried: CarriedContact, *, setup: DynamicsSetup, spec: LubricationSpec, modulus: float | FloatArray
+    carried: CarriedContact, *, setup: DynamicsSetup, spec: LubricationSpec, modulus: float
 ) -> FloatArray:
     """The film ratio λ of a carried contact (as :func:`~camcad.dynamics.film.analyse_film` on the samples).
 

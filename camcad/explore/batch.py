@@ -541,7 +541,11 @@ def _duty_answers(
     track = all(d.life is not None and d.life.track is not None for d in designs)
     if not (film or track):
         return [[] for _ in designs]
-    kinds: tuple[Kind, ...] = (("min",) if film else ()) + (("max",) if track else ())
+    kinds: tuple[Kind, ...] = ()
+    if film:
+        kinds += ("min",)
+    if track:
+        kinds += ("max",)
     kq = len(kinds)
     lubrications = [d.lubrication for d in designs]
     moduli = [
@@ -575,13 +579,12 @@ def _duty_answers(
         )
 
     def evaluate(p: FloatArray, st: CamState, which: np.ndarray, side: Side, at: Any) -> FloatArray:
-        from camcad.geometry.cam import Cam
 
         setup_at, lubrication_at, modulus_at = at
         view = replace(group.cams[0])  # the cam, its follower the stacked one
         view._memo["follower"] = group.stack.at(which)
         setup = setup_at(which)
-        carried = carried_in_state(cast(Cam, view), p, st, setup=setup, side=side)
+        carried = carried_in_state(view, p, st, setup=setup, side=side)
         out = []
         if film:
             out.append(
