@@ -11,11 +11,17 @@ are analysed together:
 
 - the motion on the sample grid is evaluated once for all of them;
 - the cam's state (envelope, profile, pressure angle, contact) on the grid
-  is evaluated once on the (variants × angles) stack, the follower's
-  parameters as one value per stacked angle (:class:`_FollowerStack`);
+  is evaluated on the (variants × angles) stack, the follower's
+  parameters as one value per stacked angle (:class:`_FollowerStack`), a
+  block of :data:`_GRID_BLOCK` variants at a time (arrays that stay in the
+  processor's cache);
 - the geometry's and the dynamics' true extremes of all variants are found
   by one search (:func:`camcad.extremes.extremes_stacked`) whose rows are
   the variants' rows, each refinement step one call of the stacked cam;
+  the lubricant film's smallest ratio and the track's largest load-stress
+  factor (``[lubrication]``, ``[life]``) by a second one (:func:`_duty_answers`);
+- the laws' VDI 2143 values (``[drive]``), which depend on the motion
+  program alone, are computed once for the group;
 - then each variant is analysed by the ordinary stages, its grid state
   handed to its cam (:meth:`camcad.geometry.cam.Cam.keep_state`) and its
   searches answered from the batch (:func:`camcad.extremes.served`).
