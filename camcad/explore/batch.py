@@ -585,7 +585,6 @@ def _duty_answers(
         )
 
     def evaluate(p: FloatArray, st: CamState, which: np.ndarray, side: Side, at: Any) -> FloatArray:
-
         setup_at, lubrication_at, modulus_at = at
         view = replace(group.cams[0])  # the cam, its follower the stacked one
         view._memo["follower"] = group.stack.at(which)
