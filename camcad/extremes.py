@@ -81,6 +81,7 @@ _XSTOP = 1e-9  # rad: a parabolic step this small has converged (the value's err
 # Where a piece's first and last sample gaps are probed, as fractions of the gap (see _probe_end_gaps):
 # next to both ends, which catches a peak right beside a joint, and at eighths.
 _END_PROBES = np.array([1e-3, *(np.arange(1, 8) / 8), 1.0 - 1e-3])
+_ROW_BLOCK = 64  # rows whose samples are scanned together (see _extremes)
 
 
 def side_text(side: Side | None) -> str:
@@ -152,27 +153,59 @@ def _rows(values: ArrayLike, k: int) -> FloatArray:
     return out.reshape(k, -1)
 
 
-def _sequence(
+@dataclass(frozen=True, slots=True)
+class _Layout:
+    """Where each row's samples go in its :class:`_Sequence`: the grid's right values, then the extra columns.
+
+    ``right`` (k, n) are the values on the grid, ``extra`` (k, j) the right
+    values at joints off the grid and the left limits at the joints; ``order``
+    (n + j,) sorts their columns into the sequence.
+    """
+
+    phi: FloatArray
+    piece: np.ndarray
+    left: np.ndarray
+    order: np.ndarray
+    right: FloatArray
+    extra: FloatArray
+
+    def rows(self, lo: int, hi: int) -> _Sequence:
+        """The sequence of rows lo … hi − 1."""
+        value = np.take(np.concatenate((self.right[lo:hi], self.extra[lo:hi]), axis=1), self.order, axis=1)
+        return _Sequence(phi=self.phi, value=value, piece=self.piece, left=self.left)
+
+
+def _layout(
     quantity: Rows, grid: FloatArray, joints: FloatArray, values: FloatArray | None, k: int
-) -> _Sequence:
+) -> _Layout:
     bounds = np.union1d(np.mod(joints, TWO_PI), [0.0])
     right = _rows(quantity(grid, "right") if values is None else values, k)
     missing = bounds[~np.isin(bounds, grid)]
+    extra = []
     if missing.size:  # a joint off the grid: add its right value too
         grid = np.concatenate((grid, missing))
-        right = np.concatenate((right, _rows(quantity(missing, "right"), k)), axis=1)
+        extra.append(_rows(quantity(missing, "right"), k))
     left_phi = np.where(bounds == 0.0, TWO_PI, bounds)
-    left = _rows(quantity(left_phi, "left"), k)
+    extra.append(_rows(quantity(left_phi, "left"), k))
     piece_grid = np.searchsorted(bounds, grid, side="right") - 1
     piece_left = np.searchsorted(bounds, left_phi, side="left") - 1  # the piece that ends there
     phi = np.concatenate((grid, left_phi))
     order = np.lexsort((phi, np.concatenate((piece_grid, piece_left))))
-    return _Sequence(
+    return _Layout(
         phi=phi[order],
-        value=np.take(np.concatenate((right, left), axis=1), order, axis=1),
         piece=np.concatenate((piece_grid, piece_left))[order],
         left=np.concatenate((np.zeros(grid.size, bool), np.ones(left_phi.size, bool)))[order],
+        order=order,
+        right=right,
+        extra=np.concatenate(extra, axis=1),
     )
+
+
+def _sequence(
+    quantity: Rows, grid: FloatArray, joints: FloatArray, values: FloatArray | None, k: int
+) -> _Sequence:
+    """The samples of every row in one sequence (right values on the grid, left limits at the joints)."""
+    return _layout(quantity, grid, joints, values, k).rows(0, k)
 
 
 @dataclass(frozen=True, slots=True)
@@ -261,6 +294,10 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
     return _Brackets(
         np.concatenate(out_rows), joined(x1), joined(x2), joined(x3), joined(f1), joined(f2), joined(f3)
     )
+
+
+def _fields(b: _Brackets) -> tuple[np.ndarray, ...]:
+    return (b.row, b.x1, b.x2, b.x3, b.f1, b.f2, b.f3)
 
 
 def _without_rests(b: _Brackets, rests: Sequence[tuple[float, float]]) -> _Brackets:
@@ -490,7 +527,7 @@ def _extremes(
             return got
     k = len(kinds)
     grid_a = np.asarray(grid, dtype=float)
-    seq = _sequence(
+    layout = _layout(
         quantity,
         grid_a,
         np.asarray(joints, dtype=float).ravel(),
@@ -498,19 +535,36 @@ def _extremes(
         k,
     )
     sign = np.array([1.0 if kind == "max" else -1.0 for kind in kinds])[:, None]
-    val = sign * np.where(np.isnan(seq.value), -sign * np.inf, seq.value)
-    top = np.argmax(val, axis=1)
-    best = val[np.arange(k), top]
+    best = np.empty(k)
+    found: list[Extreme] = []
     twins: dict[int, int] = {}
-    found = [
-        Extreme(
-            value=float(seq.value[r, top[r]]),
-            phi=float(seq.phi[top[r]]),
-            side=_sample_side(seq, r, int(top[r]), twins),
-        )
-        for r in range(k)
-    ]
-    br = _without_rests(_brackets(seq, val, best), rests)
+    parts: list[_Brackets] = []
+    # the samples' extremes and the brackets, _ROW_BLOCK rows at a time (each row's alone: a block's
+    # arrays stay in the processor's cache when a batch stacks the rows of many analyses)
+    for lo in range(0, k, _ROW_BLOCK):
+        hi = min(k, lo + _ROW_BLOCK)
+        seq = layout.rows(lo, hi)
+        sg = sign[lo:hi]
+        val = sg * np.where(np.isnan(seq.value), -sg * np.inf, seq.value)
+        top = np.argmax(val, axis=1)
+        best[lo:hi] = val[np.arange(hi - lo), top]
+        found += [
+            Extreme(value=v, phi=f, side=side)
+            for v, f, side in zip(
+                seq.value[np.arange(hi - lo), top].tolist(),
+                seq.phi[top].tolist(),
+                _sample_sides(seq, top, twins),
+                strict=True,
+            )
+        ]
+        b = _brackets(seq, val, best[lo:hi])
+        parts.append(_Brackets(b.row + lo, b.x1, b.x2, b.x3, b.f1, b.f2, b.f3))
+    br = (
+        parts[0]
+        if len(parts) == 1
+        else _Brackets(*(np.concatenate(f) for f in zip(*(_fields(b) for b in parts), strict=True)))
+    )
+    br = _without_rests(br, rests)
     if any(settled):
         searched: np.ndarray = np.logical_not(np.asarray(settled, dtype=bool))[br.row]
         br = _select(br, searched)
@@ -635,6 +689,24 @@ def _sample_side(seq: _Sequence, row: int, k: int, twins: dict[int, int] | None 
     return "right" if twin >= 0 and not _same(value[twin], value[k]) else None
 
 
+def _sample_sides(seq: _Sequence, top: np.ndarray, twins: dict[int, int]) -> list[Side | None]:
+    """:func:`_sample_side` of sample ``top[r]`` of every row r, all rows at once (the same rule)."""
+    for k in np.unique(top).tolist():
+        if k not in twins:
+            _sample_side(seq, 0, k, twins)  # finds and keeps the sample's twin
+    twin = np.array([twins[k] for k in top.tolist()], dtype=int)
+    rows = np.arange(top.size)
+    x = seq.value[rows, np.maximum(twin, 0)]
+    y = seq.value[rows, top]
+    with np.errstate(invalid="ignore"):  # _same, elementwise
+        same = (x == y) | (np.abs(x - y) <= _CONTINUOUS_RTOL * np.maximum(np.abs(x), np.abs(y)))
+    paired = twin >= 0
+    left = seq.left[top]
+    words: list[Side | None] = [None, "left", "right"]
+    code = np.where(left, np.where(paired & same, 0, 1), np.where(paired & ~same, 2, 0))
+    return [words[c] for c in code.tolist()]
+
+
 def _same(x: float, y: float) -> bool:
     """Whether two one-sided limits agree to round-off (the quantity is continuous there)."""
     return bool(x == y or abs(x - y) <= _CONTINUOUS_RTOL * max(abs(x), abs(y)))
@@ -686,7 +758,13 @@ class _Answers:
 
 def _same_bits(a: FloatArray, b: FloatArray) -> bool:
     """Whether two arrays hold the same numbers bit for bit (−0.0 is not 0.0, NaN is NaN)."""
-    return a.shape == b.shape and np.ascontiguousarray(a).tobytes() == np.ascontiguousarray(b).tobytes()
+    if a.shape != b.shape:
+        return False
+    if a.dtype == b.dtype == np.float64:  # the bits as integers, compared in place (no copies)
+        return bool(
+            np.array_equal(np.ascontiguousarray(a).view(np.int64), np.ascontiguousarray(b).view(np.int64))
+        )
+    return np.ascontiguousarray(a).tobytes() == np.ascontiguousarray(b).tobytes()
 
 
 _SERVED: ContextVar[_Answers | None] = ContextVar("camcad_extremes_served", default=None)

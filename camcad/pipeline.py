@@ -692,12 +692,16 @@ def _write_barrel_files(
     return written
 
 
-def part_duties(design: Design, cam: Cam, results: Sequence[PartResult]) -> tuple[list[PartResult], Any]:
+def part_duties(
+    design: Design, cam: Cam, results: Sequence[PartResult], *, characteristics: Any = None
+) -> tuple[list[PartResult], Any]:
     """Every part's life and film by the same code, and the train's drive ([life], [lubrication], [drive]).
 
     Each part is loaded through its own roller and drive sign (Johnson 1985,
     §4.3); the motor turns the camshaft, so the drive is a figure of the
     follower train, computed once from the first part's dynamics.
+    ``characteristics`` are the laws' VDI 2143 values if already computed
+    (:func:`camcad.dynamics.duty.analyse_train_drive`).
     """
     from camcad.dynamics.duty import analyse_duty, analyse_train_drive
 
@@ -719,7 +723,9 @@ def part_duties(design: Design, cam: Cam, results: Sequence[PartResult]) -> tupl
 
     train = None
     if design.drive is not None:
-        train = analyse_train_drive(cam, results[0].dynamics, setup=setup, spec=design.drive)
+        train = analyse_train_drive(
+            cam, results[0].dynamics, setup=setup, spec=design.drive, characteristics=characteristics
+        )
     return [duty_of(r) for r in results], train
 
 

@@ -148,3 +148,50 @@ def test_a_probe_that_only_ties_the_end_of_a_piece_is_not_searched():
     (top,) = extremes_rows(quantity, GRID, [1.0], ("max",))
     assert (top.value, top.phi, top.side) == (1.0, 1.0, "left")  # the closed form: the limit at the joint
     assert len(calls) <= 4  # the grid, the joint's limits, the end gaps' probes: no search
+
+
+def _jumpy_rows(seed: int, k: int):
+    """k random smooth rows over the turn, each jumping (or not) at three joints; and the joints."""
+    rng = np.random.default_rng(seed)
+    joints = np.sort(rng.choice(GRID[1:], 3, replace=False))
+    amp, phase = rng.normal(size=(k, 4)), rng.uniform(0, 2 * math.pi, (k, 4))
+    steps = rng.normal(size=(k, 4)) * (rng.uniform(size=(k, 1)) < 0.6)  # some rows continuous
+
+    def rows(phi, side):
+        p = np.asarray(phi, dtype=float)
+        piece = np.searchsorted(joints, p, side="left" if side == "left" else "right")
+        waves = sum(amp[:, [j]] * np.sin((j + 1) * p + phase[:, [j]]) for j in range(4))
+        return waves + np.take_along_axis(steps, np.broadcast_to(piece, (k, p.size)) % 4, axis=1)
+
+    return rows, joints, rng
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), k=st.integers(1, 9), block=st.integers(1, 4))
+def test_rows_scanned_in_blocks_give_the_extremes_of_one_scan(seed, k, block):
+    """The samples' scan in blocks of rows (as a batch's many rows are) changes no bit of any extreme."""
+    import camcad.extremes as ex
+
+    rows, joints, rng = _jumpy_rows(seed, k)
+    kinds = tuple(rng.choice(["min", "max"], k).tolist())
+    whole = extremes_rows(rows, GRID, joints, kinds)
+    kept = ex._ROW_BLOCK
+    try:
+        ex._ROW_BLOCK = block
+        blocked = extremes_rows(rows, GRID, joints, kinds)
+    finally:
+        ex._ROW_BLOCK = kept
+    assert blocked == whole
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), k=st.integers(1, 9))
+def test_every_rows_sample_side_at_once_is_each_rows_alone(seed, k):
+    """The vectorised side of each row's sample (_sample_sides) is the one-row rule (_sample_side)."""
+    import camcad.extremes as ex
+
+    rows, joints, rng = _jumpy_rows(seed, k)
+    seq = ex._sequence(rows, GRID, joints, None, k)
+    at_joints = np.flatnonzero(np.isin(np.mod(seq.phi, 2 * math.pi), joints) | (seq.phi == 0.0))
+    top = rng.choice(np.concatenate((at_joints, rng.integers(0, seq.phi.size, 4))), k)
+    assert ex._sample_sides(seq, top, {}) == [ex._sample_side(seq, r, int(top[r])) for r in range(k)]

@@ -74,7 +74,7 @@ from camcad.findings import Finding
 if TYPE_CHECKING:
     from camcad.dynamics.results import DynamicsResult
     from camcad.dynamics.spec import DynamicsSetup
-    from camcad.geometry.cam import Cam
+    from camcad.geometry.cam import Cam, CamState
     from camcad.geometry.curves import CurveSample
     from camcad.motion.program import Motion
 
@@ -85,6 +85,9 @@ __all__ = [
     "analyse_duty",
     "analyse_train_drive",
     "carried_contact",
+    "carried_in_state",
+    "film_ratio_of",
+    "track_factor_of",
 ]
 
 _MM2_PER_M2 = 1e6
@@ -372,17 +375,23 @@ def analyse_duty(
 
 
 def analyse_train_drive(
-    cam: Cam, dynamics: DynamicsResult, *, setup: DynamicsSetup, spec: DriveSpec
+    cam: Cam,
+    dynamics: DynamicsResult,
+    *,
+    setup: DynamicsSetup,
+    spec: DriveSpec,
+    characteristics: tuple[tuple[int, str, CharacteristicValues], ...] | None = None,
 ) -> DriveDuty:
     """The motor's duty and the laws' VDI 2143 values: figures of the follower train, not of a part.
 
     ``dynamics`` is any part's (the camshaft torque is the same whichever part
-    drives); ``setup`` the design's dynamics options.
+    drives); ``setup`` the design's dynamics options. ``characteristics`` is
+    ``segment_characteristics(cam.program)`` if already computed (a batch of
+    variants of one motion program shares it).
     """
-    return DriveDuty(
-        drive=_drive(cam, dynamics, setup=setup, spec=spec),
-        characteristics=segment_characteristics(cam.program),
-    )
+    if characteristics is None:
+        characteristics = segment_characteristics(cam.program)
+    return DriveDuty(drive=_drive(cam, dynamics, setup=setup, spec=spec), characteristics=characteristics)
 
 
 def _joints(cam: Cam) -> list[float]:
@@ -394,11 +403,56 @@ def _carried_at(cam: Cam, setup: DynamicsSetup) -> Callable[[FloatArray, Side], 
     model = _model(setup)
 
     def at(p: FloatArray, side: Side) -> CarriedContact:
-        st = cam.state(p, side=side)
-        force = model(st.motion, st.pressure_angle, st.profile.rho, st.lever).force
-        return carried_contact(cam, p, force, setup=setup, profile=st.profile, motion=st.motion, side=side)
+        return carried_in_state(cam, p, cam.state(p, side=side), setup=setup, side=side, model=model)
 
     return at
+
+
+def carried_in_state(
+    cam: Cam,
+    phi: FloatArray,
+    state: CamState,
+    *,
+    setup: DynamicsSetup,
+    side: Side = "right",
+    model: Any = None,
+) -> CarriedContact:
+    """:func:`carried_contact` under the rigid model's force, from the cam's state at angles φ (n,) [rad].
+
+    ``model`` is ``_model(setup)`` if already built. The exact searches of
+    :func:`analyse_duty` evaluate it; a batch analysis
+    (:mod:`camcad.explore.batch`) evaluates it on many variants at once,
+    with ``cam``, ``state`` and ``setup`` holding one value per angle.
+    """
+    st = state
+    force = (_model(setup) if model is None else model)(
+        st.motion, st.pressure_angle, st.profile.rho, st.lever
+    ).force
+    return carried_contact(cam, phi, force, setup=setup, profile=st.profile, motion=st.motion, side=side)
+
+
+def film_ratio_of(
+    carried: CarriedContact, *, setup: DynamicsSetup, spec: LubricationSpec, modulus: float
+) -> FloatArray:
+    """The film ratio λ of a carried contact (as :func:`~camcad.dynamics.film.analyse_film` on the samples).
+
+    ``modulus`` is the contact modulus E* [MPa] (:func:`~camcad.dynamics.contact.effective_modulus`).
+    """
+    h = minimum_film_thickness(
+        load_per_length=carried.load / setup.contact_length,
+        speed=carried.motion.entraining_speed,
+        curvature=carried.curvature,
+        modulus=reduced_modulus(modulus),
+        viscosity_Pa_s=spec.viscosity_Pa_s,
+        pressure_viscosity_coefficient=spec.pressure_viscosity_coefficient,
+    )
+    rq = (spec.roughness_cam_um, spec.roughness_follower_um)
+    return film_ratio(h * 1e3, roughness_cam_um=rq[0], roughness_follower_um=rq[1])
+
+
+def track_factor_of(carried: CarriedContact, *, setup: DynamicsSetup) -> FloatArray:
+    """The track's load-stress factor of a carried contact (as :func:`~camcad.dynamics.life.track_life`)."""
+    return load_stress_factor(carried.load, curvature=carried.curvature, length=setup.contact_length)
 
 
 def _exact_film(
@@ -408,17 +462,7 @@ def _exact_film(
     at = _carried_at(cam, setup)
 
     def ratio(p: FloatArray, side: Side) -> FloatArray:
-        carried = at(p, side)
-        h = minimum_film_thickness(
-            load_per_length=carried.load / setup.contact_length,
-            speed=carried.motion.entraining_speed,
-            curvature=carried.curvature,
-            modulus=reduced_modulus(modulus),
-            viscosity_Pa_s=spec.viscosity_Pa_s,
-            pressure_viscosity_coefficient=spec.pressure_viscosity_coefficient,
-        )
-        rq = (spec.roughness_cam_um, spec.roughness_follower_um)
-        return film_ratio(h * 1e3, roughness_cam_um=rq[0], roughness_follower_um=rq[1])
+        return film_ratio_of(at(p, side), setup=setup, spec=spec, modulus=modulus)
 
     if not np.isfinite(film.min_ratio):
         return film
@@ -442,8 +486,7 @@ def _exact_track(
     at = _carried_at(cam, setup)
 
     def factor(p: FloatArray, side: Side) -> FloatArray:
-        carried = at(p, side)
-        return load_stress_factor(carried.load, curvature=carried.curvature, length=setup.contact_length)
+        return track_factor_of(at(p, side), setup=setup)
 
     high = maximum(factor, phi, _joints(cam), values=track.factor)
     if spec.track is None or not high.value > track.factor_max:

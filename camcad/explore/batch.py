@@ -11,11 +11,17 @@ are analysed together:
 
 - the motion on the sample grid is evaluated once for all of them;
 - the cam's state (envelope, profile, pressure angle, contact) on the grid
-  is evaluated once on the (variants × angles) stack, the follower's
-  parameters as one value per stacked angle (:class:`_FollowerStack`);
+  is evaluated on the (variants × angles) stack, the follower's
+  parameters as one value per stacked angle (:class:`_FollowerStack`), a
+  block of :data:`_GRID_BLOCK` variants at a time (arrays that stay in the
+  processor's cache);
 - the geometry's and the dynamics' true extremes of all variants are found
   by one search (:func:`camcad.extremes.extremes_stacked`) whose rows are
   the variants' rows, each refinement step one call of the stacked cam;
+  the lubricant film's smallest ratio and the track's largest load-stress
+  factor (``[lubrication]``, ``[life]``) by a second one (:func:`_duty_answers`);
+- the laws' VDI 2143 values (``[drive]``), which depend on the motion
+  program alone, are computed once for the group;
 - then each variant is analysed by the ordinary stages, its grid state
   handed to its cam (:meth:`camcad.geometry.cam.Cam.keep_state`) and its
   searches answered from the batch (:func:`camcad.extremes.served`).
@@ -329,19 +335,53 @@ def _group(designs: list[Design]) -> _Group:
 
 def _state_slice(state: CamState, lo: int, hi: int) -> CamState:
     """The rows lo … hi − 1 of a stacked state (one variant's grid)."""
+    return _state_take(state, slice(lo, hi))
+
+
+def _state_take(state: CamState, index: np.ndarray | slice) -> CamState:
+    """The rows ``index`` of a stacked state."""
 
     def curve(c: CurveSample) -> CurveSample:
-        return replace(c, **{f.name: getattr(c, f.name)[lo:hi] for f in fields(c)})
+        return replace(c, **{f.name: getattr(c, f.name)[index] for f in fields(c)})
 
     return replace(
         state,
-        motion=_take(state.motion, slice(lo, hi)),
+        motion=_take(state.motion, index),
         base=curve(state.base),
         profile=curve(state.profile),
-        pressure_angle=state.pressure_angle[lo:hi],
-        contact_position=state.contact_position[lo:hi],
-        lever=None if state.lever is None else state.lever[lo:hi],
+        pressure_angle=state.pressure_angle[index],
+        contact_position=state.contact_position[index],
+        lever=None if state.lever is None else state.lever[index],
     )
+
+
+_GRID_BLOCK = 8
+"""Variants whose grid state and rows are evaluated together (in blocks: their arrays stay in cache)."""
+
+
+@dataclass(frozen=True, slots=True)
+class _Block:
+    """Variants first … first + count − 1 on their stacked grid: its angles, their variant, the state."""
+
+    first: int
+    count: int
+    phi: FloatArray
+    which: np.ndarray
+    state: CamState
+
+
+def _by_variant(values: FloatArray, k: int, nv: int, m: int) -> FloatArray:
+    """(k, V·m) k rows at the angles of V variants in turn → (V·k, m), variant after variant."""
+    out: FloatArray = values.reshape(k, nv, m).transpose(1, 0, 2).reshape(nv * k, m)
+    return out
+
+
+def _block_rows(blocks: Sequence[_Block], rows: Any, k: int, nv: int, n: int) -> FloatArray:
+    """(V·k, n) the k grid rows of every variant, variant after variant, ``rows(block)`` (k, count·n) each."""
+    out = np.empty((nv, k, n))
+    for b in blocks:
+        out[b.first : b.first + b.count] = np.reshape(rows(b), (k, b.count, n)).transpose(1, 0, 2)
+    return out.reshape(nv * k, n)
 
 
 Answer = tuple[
@@ -368,14 +408,23 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
     loop = cast(Cam, _Loop(group.pitch))
     joints = np.array([bp.phi for bp in group.cams[0].program.breakpoints], dtype=float)
     rests = group.cams[0].rests
-    every = np.repeat(np.arange(nv), n)
-    tiled = _tile(group.grid_motion, nv)
-    for sigma in (group.sigma, -group.sigma):  # the grid's turn, once for all the variants
-        keep_turn(
-            tiled.phi, sigma, np.tile(np.cos(sigma * group.phi), nv), np.tile(np.sin(sigma * group.phi), nv)
+    # the grid state of _GRID_BLOCK variants at a time (arrays that stay in the processor's cache), each
+    # block's stacked grid one tiled motion, turned by the grid's own cos and sin
+    turn = {
+        sigma: (np.cos(sigma * group.phi), np.sin(sigma * group.phi)) for sigma in (group.sigma, -group.sigma)
+    }
+    tiles: dict[int, Motion] = {}
+    blocks: list[_Block] = []
+    for v0 in range(0, nv, _GRID_BLOCK):
+        count = min(_GRID_BLOCK, nv - v0)
+        tiled = tiles.setdefault(count, _tile(group.grid_motion, count))
+        for sigma, (cos, sin) in turn.items():
+            keep_turn(tiled.phi, sigma, np.tile(cos, count), np.tile(sin, count))
+        which = np.repeat(np.arange(v0, v0 + count), n)
+        blocks.append(
+            _Block(first=v0, count=count, phi=tiled.phi, which=which, state=group.state(tiled, which))
         )
-    stacked = group.state(tiled, every)
-    states = [_state_slice(stacked, v * n, (v + 1) * n) for v in range(nv)]
+    states = [_state_slice(b.state, i * n, (i + 1) * n) for b in blocks for i in range(b.count)]
 
     def stacked_at(p: FloatArray, which: np.ndarray, side: Side) -> CamState:
         return group.state(group.motion(p, side), which)
@@ -434,10 +483,9 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
 
     def by_variant(values: FloatArray, m: int) -> FloatArray:
         """(k, V·m) rows of the variants' angles in turn → (V·k, m), variant after variant."""
-        out: FloatArray = values.reshape(k, nv, m).transpose(1, 0, 2).reshape(nv * k, m)
-        return out
+        return _by_variant(values, k, nv, m)
 
-    values = by_variant(both(stacked, every), n)
+    values = _block_rows(blocks, lambda b: both(b.state, b.which), k, nv, n)
 
     def quantity(p: FloatArray, side: Side) -> FloatArray:
         m = p.size
@@ -471,10 +519,136 @@ def _searches(group: _Group) -> tuple[list[CamState], list[list[Answer]]]:
                 (group.phi, joints, kinds, values[mid:hi], rests, models[owner[v]][0][1][1], found[mid:hi]),
             ]
         )
+    for mine, more in zip(answers, _duty_answers(group, setups, blocks, joints), strict=True):
+        mine += more
     return states, answers
 
 
-def _assemble(design: Design, cam: Cam) -> Analysis:
+def _duty_answers(
+    group: _Group, setups: Sequence[Any], blocks: Sequence[_Block], joints: FloatArray
+) -> list[list[Answer]]:
+    """The answers of each variant's film and track searches (:func:`~camcad.dynamics.duty.analyse_duty`).
+
+    The lubricant film's smallest ratio λ and the track's largest load-stress
+    factor are searched on the exact cam as the geometry's and the dynamics'
+    extremes are: one stacked search for all the variants, its quantity
+    :func:`~camcad.dynamics.duty.film_ratio_of` and
+    :func:`~camcad.dynamics.duty.track_factor_of` of
+    :func:`~camcad.dynamics.duty.carried_in_state` with the stacked cam and
+    setup. Empty where the designs have neither (or not all of them the same).
+    """
+    from camcad.dynamics.contact import effective_modulus
+    from camcad.dynamics.duty import carried_in_state, film_ratio_of, track_factor_of
+    from camcad.extremes import extremes_stacked
+
+    nv, n = group.size, group.phi.size
+    designs = group.designs
+    film = all(d.lubrication is not None for d in designs)
+    track = all(d.life is not None and d.life.track is not None for d in designs)
+    if not (film or track):
+        return [[] for _ in designs]
+    kinds: tuple[Kind, ...] = ()
+    if film:
+        kinds += ("min",)
+    if track:
+        kinds += ("max",)
+    kq = len(kinds)
+    lubrications = [d.lubrication for d in designs]
+    moduli = [
+        effective_modulus(
+            modulus_1=s.spec.cam_modulus,
+            poisson_1=s.spec.cam_poisson,
+            modulus_2=s.spec.follower_modulus,
+            poisson_2=s.spec.follower_poisson,
+        )
+        for s in setups
+    ]
+    # variants with equal setups, lubricants and moduli share one evaluation; different ones, one of
+    # stacked parameters (each one value per angle), or, where a function takes a parameter as a
+    # scalar, one evaluation per kind of variant on its own angles
+    keys: list[tuple[Any, Any, float]] = []
+    owner = np.empty(nv, dtype=int)
+    for v, key in enumerate(zip(setups, lubrications, moduli, strict=True)):
+        for g, held in enumerate(keys):
+            if held == key:
+                owner[v] = g
+                break
+        else:
+            owner[v] = len(keys)
+            keys.append(key)
+    stacked: list[Any] = [None]
+    if len(keys) > 1:
+        stacked[0] = (
+            _Stacked.of(setups).at,
+            _Stacked.of(lubrications).at if film else None,
+            np.array(moduli, dtype=float).__getitem__,
+        )
+
+    def evaluate(p: FloatArray, st: CamState, which: np.ndarray, side: Side, at: Any) -> FloatArray:
+        setup_at, lubrication_at, modulus_at = at
+        view = replace(group.cams[0])  # the cam, its follower the stacked one
+        view._memo["follower"] = group.stack.at(which)
+        setup = setup_at(which)
+        carried = carried_in_state(view, p, st, setup=setup, side=side)
+        out = []
+        if film:
+            out.append(
+                film_ratio_of(carried, setup=setup, spec=lubrication_at(which), modulus=modulus_at(which))
+            )
+        if track:
+            out.append(track_factor_of(carried, setup=setup))
+        return np.vstack(out)
+
+    def rows(p: FloatArray, st: CamState, which: np.ndarray, side: Side) -> FloatArray:
+        """(kq, m) the film ratio and/or track factor at each angle, of the angle's own variant."""
+        if stacked[0] is not None:
+            try:
+                return evaluate(p, st, which, side, stacked[0])
+            except (TypeError, ValueError, AttributeError):  # a function takes a parameter as a scalar
+                stacked[0] = None
+        out = np.empty((kq, p.size))
+        for g, (setup, lubrication, modulus) in enumerate(keys):
+            mine = np.flatnonzero(owner[which] == g)
+            at = (lambda w, s=setup: s, lambda w, lub=lubrication: lub, lambda w, e=modulus: e)
+            if mine.size == p.size:
+                return evaluate(p, st, which, side, at)
+            if mine.size:
+                out[:, mine] = evaluate(p[mine], _state_take(st, mine), which[mine], side, at)
+        return out
+
+    values = _block_rows(blocks, lambda b: rows(b.phi, b.state, b.which, "right"), kq, nv, n)
+
+    def quantity(p: FloatArray, side: Side) -> FloatArray:
+        m = p.size
+        which = np.repeat(np.arange(nv), m)
+        tiled = np.tile(p, nv)
+        return _by_variant(rows(tiled, group.state(group.motion(tiled, side), which), which, side), kq, nv, m)
+
+    def pick(p: FloatArray, which_rows: np.ndarray, side: Side) -> FloatArray:
+        which = which_rows // kq
+        got = rows(p, group.state(group.motion(p, side), which), which, side)
+        out: FloatArray = got[which_rows % kq, np.arange(p.size)]
+        return out
+
+    found = extremes_stacked(quantity, pick, group.phi, joints, kinds * nv, values=values)
+    return [
+        [
+            (
+                group.phi,
+                joints,
+                (kind,),
+                values[v * kq + q : v * kq + q + 1],
+                (),
+                (),
+                found[v * kq + q : v * kq + q + 1],
+            )
+            for q, kind in enumerate(kinds)
+        ]
+        for v in range(nv)
+    ]
+
+
+def _assemble(design: Design, cam: Cam, characteristics: Any = None) -> Analysis:
     """:func:`analyse_one` for a plate cam whose grid state and searches are at hand (the same stages)."""
     from camcad.analysis import Analysis, PartResult
     from camcad.dynamics import analyse_dynamics
@@ -513,7 +687,7 @@ def _assemble(design: Design, cam: Cam) -> Analysis:
     if design.life is not None or design.lubrication is not None or design.drive is not None:
         from camcad.pipeline import part_duties  # the same per-part life, film and train drive
 
-        results, drive = part_duties(design, cam, results)
+        results, drive = part_duties(design, cam, results, characteristics=characteristics)
     return Analysis(
         design=design, family=family, parts=tuple(results), motion=motion, toolpath=None, drive=drive
     )
@@ -600,11 +774,16 @@ def _batched(designs: list[Design], stats: BatchStats) -> list[Analysis | Camcad
         return None
     out: list[Analysis | CamcadError] = []
     shared: Any = None
+    characteristics = None
+    if any(d.drive is not None for d in designs):  # the laws' VDI 2143 values: of the one motion program
+        from camcad.dynamics.drive import segment_characteristics
+
+        characteristics = segment_characteristics(group.cams[0].program)
     for design, cam, state, mine in zip(designs, group.cams, states, answers, strict=True):
         cam.keep_state(group.phi, replace(state, motion=group.grid_motion))
         with served(mine) as held:
             try:
-                analysis = _assemble(design, cam)
+                analysis = _assemble(design, cam, characteristics)
             except CamcadError as err:
                 out.append(err)
                 continue

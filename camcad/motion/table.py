@@ -129,6 +129,29 @@ class TableFit:
         return float(abs(self.residual[i])), float(self.angle[i])
 
 
+@functools.lru_cache(maxsize=16)
+def _critical(
+    knot_vector: tuple[float, ...], coefficients: tuple[float, ...]
+) -> tuple[float, tuple[float, float]]:
+    """:attr:`TableLaw.peak` and :attr:`TableLaw.trough` of one spline, kept for the spline's next designs.
+
+    A sweep parses one table once per variant: its spline, and so these
+    (a root finder's work), are the same each time.
+    """
+    from scipy.interpolate import BSpline, PPoly
+
+    spline = BSpline(np.asarray(knot_vector), np.asarray(coefficients), 5, extrapolate="periodic")
+    roots = PPoly.from_spline(spline.derivative()).roots(extrapolate=False)  # where v = 0
+    roots = roots[np.isfinite(roots)]
+    knots = np.asarray(knot_vector)
+    peak = float(np.max(spline(np.concatenate([roots, knots]))))
+    interior = knots[5:-5]  # the knots_phi of TableLaw
+    phi = np.mod(np.concatenate([roots, interior]), TWO_PI)
+    s = spline(phi)
+    i = int(np.argmin(s))
+    return peak, (float(s[i]), float(phi[i]))
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class TableLaw(Law):
     """The smoothing spline of a point table, as a law over the whole turn.
@@ -170,12 +193,7 @@ class TableLaw(Law):
     @property
     def peak(self) -> float:
         """Largest displacement of the smooth law [mm]: the spline at the roots of its velocity."""
-        spline = self._spline()
-        from scipy.interpolate import PPoly
-
-        roots = PPoly.from_spline(spline.derivative()).roots(extrapolate=False)  # where v = 0
-        knots = np.asarray(self.knot_vector)
-        return float(np.max(spline(np.concatenate([roots[np.isfinite(roots)], knots]))))
+        return _critical(self.knot_vector, self.coefficients)[0]
 
     @property
     def trough(self) -> tuple[float, float]:
@@ -184,14 +202,7 @@ class TableLaw(Law):
         Exact to the root finder: s is a quintic on each knot span, so its
         minimum lies at a root of the quartic v = ds/dφ or at a span's end.
         """
-        spline = self._spline()
-        from scipy.interpolate import PPoly
-
-        roots = PPoly.from_spline(spline.derivative()).roots(extrapolate=False)  # where v = 0
-        phi = np.mod(np.concatenate([roots[np.isfinite(roots)], np.asarray(self.knots_phi)]), TWO_PI)
-        s = spline(phi)
-        i = int(np.argmin(s))
-        return float(s[i]), float(phi[i])
+        return _critical(self.knot_vector, self.coefficients)[1]
 
     @property
     def knots(self) -> tuple[float, ...]:

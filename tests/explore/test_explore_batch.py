@@ -331,3 +331,42 @@ def test_served_answers_only_the_same_bits() -> None:
         got = extremes_rows(rows, grid, [0.0], ("max", "min"), values=flipped)
         assert got != marker and held.used == 0
         assert got[0].value == pytest.approx(1.0) and got[1].value == pytest.approx(-1.0)
+
+
+@settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(scales=st.lists(st.lists(_SCALE, min_size=4, max_size=4), min_size=3, max_size=3))
+def test_duty_searches_batched_and_equal(scales: list[list[float]]) -> None:
+    """Life, film and drive ([life] with a track, [lubrication], [drive]): every summary byte as alone.
+
+    The exact film and track searches of each variant are answered by the
+    stacked one (four served searches a design: geometry, dynamics, film,
+    track), and the summaries (the film's smallest ratio and its angle, the
+    track's life, the laws' VDI 2143 values, the motor) are those of
+    :func:`camcad.pipeline.analyse` on each design alone.
+    """
+    from camcad.explore.batch import analyse_many
+
+    data = sample_data("indexing_drive")
+    data["life"] |= {"track_slope": 8.0, "track_intercept": 34.0}
+    keys = ("cam.base_radius", "cam.speed_rpm", "follower.roller_radius", "lubrication.viscosity_Pa_s")
+
+    def base(key: str) -> float:
+        table, name = key.split(".")
+        return float(data[table][name])
+
+    variables = [
+        parse_variable(f"{k}={0.85 * base(k)!r}:{1.25 * base(k)!r}", data, flag="--vary", counted=False)
+        for k in keys
+    ]
+    designs = [
+        design_with(data, variables, tuple(base(k) * s for k, s in zip(keys, row, strict=True)))
+        for row in scales
+    ]
+    stats = BatchStats()
+    got = analyse_many(designs, stats=stats)
+    alone = [analyse(d, fit=False, toolpath=False, strict=False) for d in designs]
+    text = [json.dumps(a.summary(), sort_keys=True, default=repr) for a in (*got, *alone)]  # type: ignore[union-attr]
+    assert text[: len(designs)] == text[len(designs) :]
+    assert "film_ratio" in text[0] and "characteristic_values" in text[0]
+    assert stats.batched == len(designs), stats
+    assert stats.served == stats.searches == 4 * len(designs), stats
