@@ -37,8 +37,8 @@ def barrel_toolpath_options(barrel: Barrel, spec: GcodeSpec) -> BarrelToolpathOp
 
     Without a stated ``tool_diameter`` the roughing cutter is the largest
     half-millimetre size within :data:`ROUGH_SHARE` of the groove's width
-    (a rib: the gap 2r_f + c each roller runs in) less the stock on both walls; ``tool_number`` roughs and the next
-    number finishes.
+    (a rib: the gap 2r_f + c each roller runs in) less the stock on both
+    walls; ``tool_number`` roughs and the next number finishes.
 
     Raises
     ------

@@ -102,7 +102,7 @@ def _swept(points: np.ndarray, passes: list[dict], kinds: tuple[str, ...], spaci
     for (kind, tip), chunks in groups.items():
         pos = np.concatenate(chunks)
         # the turn is periodic: the positions again a turn either way, so the ±0.3 rad window wraps
-        wrap = np.concatenate([pos + [0.0, 0.0, k] for k in (-360.0, 0.0, 360.0)])
+        wrap = np.concatenate([pos + np.array([0.0, 0.0, k]) for k in (-360.0, 0.0, 360.0)])
         out = np.minimum(out, _swept_distance(points, phi, wrap, tip, radius[kind], 0.0))
     return out
 
