@@ -199,7 +199,10 @@ class BarrelToolpath:
     roller (its finishing cutter is tapered, not smaller). ``root_fillet``
     [mm]: a rib's faces at the root station b stand up to this far outside
     the root cylinder, the most a flat end leaves beside them there (module
-    notes); 0 for a groove.
+    notes); ``floor_rise`` [mm]: how far above the root a rib's floor stays
+    where a roughing cutter's axis runs more than its radius off the
+    barrel's axis (an arm), √(b² + (|y| − r_c)²) − b at the largest |y|;
+    both 0 for a groove.
     """
 
     passes: tuple[BarrelPass, ...]
@@ -207,6 +210,7 @@ class BarrelToolpath:
     barrel: BarrelOptions
     small_cutter: FloatArray
     root_fillet: float = 0.0
+    floor_rise: float = 0.0
 
     @property
     def max_deviation(self) -> float:
@@ -485,8 +489,14 @@ def _plan_rib(
         program.evaluate(program.sample_phi(math.radians(0.05))), follower, options, stations[:1]
     )
     edge = max(float(np.hypot(f.point[..., 0], f.point[..., 1]).max()) for f in (faces.upper, faces.lower))
+    off = max(0.0, max(float(np.abs(p.y).max()) for p in passes if p.kind == "rough") - r_c)
     return BarrelToolpath(
-        passes=tuple(passes), options=spec, barrel=options, small_cutter=small, root_fillet=edge - bottom
+        passes=tuple(passes),
+        options=spec,
+        barrel=options,
+        small_cutter=small,
+        root_fillet=edge - bottom,
+        floor_rise=math.hypot(bottom, off) - bottom,
     )
 
 

@@ -207,6 +207,41 @@ def test_a_ribs_passes_keep_off_the_faces_and_finish_them_exactly(lift, span, wi
     assert max(x.min() for x in rough_x) >= o.length and min(x.max() for x in rough_x) <= 0.0
 
 
+def test_an_arm_ribs_passes_keep_off_its_faces_and_finish_them():
+    """A rib on the arm sample's follower (yokes ±h across the arm's end): in the developed plane at the
+    root, pitch and top the finishing cutters lie on the exact faces (the lower layer's walls of each
+    of its rollers), the roughing cutters keep the stock off them; its axis runs |y| > r_c off the
+    barrel's axis, so the floor's rise is reported."""
+    from scipy.spatial import cKDTree
+
+    from camcad.geometry.barrel import BarrelKind, rib_rollers
+    from tests.barrel_cases import ARM
+
+    o = replace(ARM.options, kind=BarrelKind.RIB, rib_width=14.0, length=ARM.options.length + 40.0)
+    follower = replace(ARM.follower, axial_position=ARM.follower.axial_position + 20.0)
+    spec = BarrelToolpathOptions(rough_diameter=9.5, tolerance=0.01)
+    tp = plan_barrel(ARM.program, follower, o, spec)
+    assert tp.max_deviation <= spec.tolerance
+    up, low = rib_rollers(follower, o)
+    rough = [p for p in tp.passes if p.kind == "rough" and p.z == o.bottom_radius]
+    motion = ARM.program.evaluate(np.linspace(0.0, 2.0 * math.pi, 1441))
+    for t in (o.bottom_radius, o.pitch_station, o.barrel_radius):
+        faces = {
+            "finish upper": developed_walls(motion, up, o, t).lower.point,
+            "finish lower": developed_walls(motion, low, o, t).upper.point,
+        }
+        tree = cKDTree(np.concatenate([_axis_at(p, t) for p in rough]))
+        for face in faces.values():
+            assert tree.query(face)[0].min() - 4.75 >= spec.stock - spec.tolerance - 1e-3
+        for p in tp.passes[-2:]:
+            d = cKDTree(_axis_at(p, t)).query(faces[p.kind])[0] - p.radius
+            assert np.abs(d).max() <= spec.tolerance + 1e-3, (t, p.kind)
+    y = max(float(np.abs(p.y).max()) for p in rough)
+    assert y > 4.75 and tp.floor_rise == pytest.approx(
+        math.hypot(o.bottom_radius, y - 4.75) - o.bottom_radius
+    )
+
+
 def test_a_ribs_small_cutter_report_is_the_flank_estimate():
     """Each face finished by the rougher, exact at the pitch station, leaves on the steepest flank
     δ(1 − cos(β_t − β_p)), δ = r_w − r_c, tan β = s′/t: the reported greatest stock at the root and

@@ -70,6 +70,11 @@ def render_barrel_program(toolpath: BarrelToolpath, *, name: str = "barrel cam")
             f"the flat ends leave a fillet up to {toolpath.root_fillet:.4f} high at the rib's root beside "
             "its flanks, where the faces' root edges stand off the root cylinder"
         )
+        if toolpath.floor_rise > 0.0:
+            head.append(
+                f"the floor round the rib stays up to {toolpath.floor_rise:.4f} above the root where the "
+                f"roughing cutter's axis runs more than its radius off the barrel's axis [Y]"
+            )
     else:
         head[-1:-1] = [
             f"finish: T{s.finish_tool} flat end mill D{2 * o.roller_radius:.3f} (the roller's diameter) "
