@@ -106,6 +106,7 @@ from scipy.spatial import cKDTree
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import DesignError
+from camcad.extremes import extremes_rows
 from camcad.geometry.barrel import (
     BarrelFollower,
     BarrelKind,
@@ -119,7 +120,7 @@ from camcad.geometry.barrel import (
 )
 from camcad.geometry.barrel_limits import developed_walls
 from camcad.knobs import Knob
-from camcad.motion.program import MotionProgram
+from camcad.motion.program import MotionProgram, Side
 
 __all__ = [
     "BarrelPass",
@@ -484,11 +485,18 @@ def _plan_rib(
     lower = small_cutter_deviation(program, low, options, r_c, stations, walls=(0,))
     small = np.stack((upper[:, 1], lower[:, 0]), axis=1)
     readonly(small)
-    # the faces' root edges: their largest radius, sampled as finely as the small cutter's walls
-    faces = barrel_faces(
-        program.evaluate(program.sample_phi(math.radians(0.05))), follower, options, stations[:1]
-    )
-    edge = max(float(np.hypot(f.point[..., 0], f.point[..., 1]).max()) for f in (faces.upper, faces.lower))
+
+    # the faces' root edges: their largest radius over the turn, a true extreme (one-sided at joints)
+    def edges(phi: FloatArray, side: Side) -> FloatArray:
+        faces = barrel_faces(program.evaluate(phi, side=side), follower, options, stations[:1])
+        out: FloatArray = np.vstack(
+            [np.hypot(f.point[:, 0, 0], f.point[:, 0, 1]) for f in (faces.upper, faces.lower)]
+        )
+        return out
+
+    joints = [bp.phi for bp in program.breakpoints]
+    found = extremes_rows(edges, program.sample_phi(math.radians(0.5)), joints, ("max", "max"))
+    edge = max(e.value for e in found)
     off = max(0.0, max(float(np.abs(p.y).max()) for p in passes if p.kind == "rough") - r_c)
     return BarrelToolpath(
         passes=tuple(passes),

@@ -245,7 +245,8 @@ def test_an_arm_ribs_passes_keep_off_its_faces_and_finish_them():
 def test_a_ribs_small_cutter_report_is_the_flank_estimate():
     """Each face finished by the rougher, exact at the pitch station, leaves on the steepest flank
     δ(1 − cos(β_t − β_p)), δ = r_w − r_c, tan β = s′/t: the reported greatest stock at the root and
-    the top is that (1 % for the turn's largest, just off the steepest point), and nothing gouges."""
+    the top is that (1 % for the turn's largest, just off the steepest point), and nothing gouges;
+    the root's fillet in closed form."""
     from tests.barrel_cases import RIB
 
     o = RIB.options
@@ -257,6 +258,11 @@ def test_a_ribs_small_cutter_report_is_the_flank_estimate():
         for j in range(2):
             assert tp.small_cutter[i, j, 0] >= -1e-9
             assert estimate <= tp.small_cutter[i, j, 1] <= 1.01 * estimate
+    # the root's fillet: the face at the root station b on the steepest flank is a = r_w·sin β across
+    # the roller's axis, √(b² + a²) from the barrel's, tan β = s′/b
+    a = (delta + 4.75) * v_star / math.hypot(v_star, o.bottom_radius)
+    assert tp.root_fillet == pytest.approx(math.hypot(o.bottom_radius, a) - o.bottom_radius, abs=1e-8)
+    assert tp.floor_rise == 0.0  # a translating follower: the tool's axis runs through the barrel's
 
 
 @pytest.mark.parametrize(
