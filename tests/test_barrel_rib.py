@@ -16,6 +16,8 @@ Independent truths:
   force distance between the two closed-form developed faces at those stations;
 - the positive drive: with no spring the torque is the power balance
   T = m·(g + s″ω²)·s′ (Norton 2009, §8.11), its largest value over the turn;
+- cam.ngc holds rough passes and one finishing pass per face (rs274 and the 3-D measure:
+  tests/readers/test_rib_program.py); a rougher wider than the gap beside the rib exits 2;
 - bad input exits 2 naming the field; a rib too thin for its flanks is a hard limit (exit 3)
   naming ``cam.rib_width``; the same input gives the same bytes.
 """
@@ -42,7 +44,7 @@ from tests.barrel_cases import RIB, assert_same_outputs, barrel_volume
 from tests.conftest import ROOT, distance_to_polygon
 
 SAMPLE = ROOT / "samples" / "barrel_rib.toml"
-FILES = ("profile.dxf", "cam.stl", "cam.step", "summary.json", "report.html")
+FILES = ("profile.dxf", "cam.stl", "cam.step", "cam.ngc", "summary.json", "report.html")
 G = 9.80665  # m/s², standard gravity
 
 
@@ -71,15 +73,24 @@ def test_the_sample_loads_to_the_rib_case():
     assert np.allclose(barrel.program.evaluate(phi).s, RIB.program.evaluate(phi).s, atol=1e-12)
 
 
-def test_build_writes_the_barrels_files_and_a_note_instead_of_a_program(folder):
+def test_build_writes_the_barrels_files_and_its_4_axis_program(folder):
+    """cam.ngc: rough passes then one finishing pass per face (rs274 reads and measures it in
+    tests/readers/test_rib_program.py); the rougher the largest half-millimetre within 0.625 of the
+    gap 2r_f + c less the stock on both sides, 2·0.625·(16.05 − 0.4) = 19.56 → 9.5 mm."""
     out = built(folder)
     for f in FILES:
         assert (out / f).stat().st_size > 0, f
-    assert not (out / "cam.ngc").exists()
     summary = _summary(folder)
-    (note,) = [f for f in summary["findings"] if f["kind"] == "no program"]
-    assert note["severity"] == "note" and note["field"] == "cam.style" and "cam.ngc" in note["message"]
-    assert "gcode" not in summary
+    assert not [f for f in summary["findings"] if f["kind"] == "no program"]
+    gcode = summary["gcode"]
+    assert gcode["tool_diameter_mm"] == 9.5
+    assert gcode["max_deviation_mm"] <= 0.005  # the [gcode] tolerance's default
+    text = (out / "cam.ngc").read_text(encoding="ascii")
+    kinds = [
+        line.split(": ", 1)[1].split(" at Z")[0] for line in text.splitlines() if line.startswith("(pass ")
+    ]
+    assert kinds[-2:] == ["finish upper", "finish lower"] and set(kinds[:-2]) == {"rough"}
+    assert "rib: 14 wide" in text and "T2 flat end mill D16.000" in text
     assert summary["fit"]["certified"] and summary["fit"]["max_error_mm"] <= summary["fit"]["tolerance_mm"]
     rib = summary["barrel"]["rib"]
     o = RIB.options
@@ -174,7 +185,7 @@ def test_rib_thickness_rows_are_the_brute_force_least_width(folder, capsys):
     for label, where in (("root", "bottom"), ("top", "top")):
         assert f"rib thickness at {label}" in out
         assert f"{rib[where]['value_mm']:.3f} mm" in out
-    assert "rib along the axis" in out and "no cam.ngc" in out
+    assert "rib along the axis" in out
 
 
 def test_the_two_rollers_drive_it_positively_by_the_power_balance(folder):
@@ -244,6 +255,18 @@ def test_a_rib_too_thin_for_its_flanks_is_a_hard_limit_naming_rib_width(tmp_path
     """The flanks narrow a 14 mm rib to 10.34 mm at its root (the brute force above): at 2 mm they cross."""
     assert main(["check", str(_bad(tmp_path, _rib_text(rib_width=2.0)))]) == 3
     assert "cam.rib_width" in capsys.readouterr().out
+
+
+def test_a_rougher_wider_than_the_gap_beside_the_rib_exits_2_naming_it(tmp_path, capsys):
+    """The gap each roller runs in is 2r_f + c = 16.05 mm; with 0.2 mm stock on each side 15.65 mm fits."""
+    text = SAMPLE.read_text(encoding="utf-8") + "\n[gcode]\ntool_diameter = 15.7\n"
+    out = tmp_path / "out"
+    assert main(["build", str(_bad(tmp_path, text)), "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "gcode.tool_diameter" in err[0] and "15.65" in err[0], err
+    assert not out.exists()
+    fits = SAMPLE.read_text(encoding="utf-8") + "\n[gcode]\ntool_diameter = 15.6\n"
+    assert main(["check", str(_bad(tmp_path, fits))]) == 0
 
 
 def test_the_editor_schema_takes_the_sample_and_refuses_rib_width_elsewhere():

@@ -52,8 +52,48 @@ roller of wall radius r_tip: that cylinder lies inside the cone over the
 stations b … R (k ≥ 0), so its groove lies inside the cone's and a cutter
 ``stock`` inside the first is at least ``stock`` inside the second.
 
-A rib (:class:`~camcad.geometry.barrel.BarrelKind`) is refused: machining
-the barrel's whole surface round a rib is not planned.
+A rib
+-----
+A rib (:class:`~camcad.geometry.barrel.BarrelKind`) stands on a core of
+radius b = R − depth, its top the blank's surface R: everything else between
+the barrel's ends 0 ≤ z ≤ ``length`` comes off down to b. Its faces are
+walls of its two rollers (:func:`~camcad.geometry.barrel.face_rollers`): the
+upper face the lower wall of the roller at +h, the lower face the upper wall
+of the roller at −h (h: ``rib_offset``), so each face is finished as a
+groove's wall is, a cutter of the roller's diameter on that roller's path
+shifted by c/2 towards the rib along its pitch station's normal (its edge
+then r_f + c/2 = r_w off the path, on the face).
+
+Roughing works on each side from its roller's path outwards: near the face,
+shifts δ along the normal from r_w − r_c − stock towards the rib out to the
+roller's path itself (the cutter stays ``stock`` off the face: every point of
+the path is r_w from it), then the path translated along the barrel's axis,
+away from the rib, in steps no wider than ``stepover`` × the cutter's
+diameter, until the cutter's axis lies beyond the barrel's end all round.
+A translated pass cannot touch the rib: at every station the developed
+roller path is a graph over u (t + y′ > 0, checked by the limits) and the rib
+lies on its other side, r_w from it, so a segment from a point beyond the
+path to the rib crosses the path and is at least r_w long. Between two
+passes at one u the gap along w is at most the step, so no point of the band
+is farther than half a step from a cutter's axis. The last level's tip is at
+the root b itself (the floor between the faces' finishing passes is cut by
+roughing alone); the faces keep the stock.
+
+For a translating follower (y ≡ 0) a flat end mill whose tip is at b leaves
+the cylinder of radius b exactly; on an arm (y ≠ 0) a point under the
+cutter's axis line is reached at station √(ρ² − y²), so the floor far from
+the rib rises where |y| > r_c (under the cutter's axis to √(b² + (|y| − r_c)²)).
+
+The root's fillet: a face point at station t lies √(t² + a²) from the
+barrel's axis, a = y + r_w·cos γ its offset across the roller's axis, so on
+a flank the face's root edge (station b) stands above the root cylinder, by
+up to F = max √(b² + a²) − b (a translating roller: a = r_w·sin β, tan β =
+s′/b). A flat end whose tip is at station b cuts the face exactly at every
+station from b up, and reaches a point of radius ρ only within acos(b/ρ) of
+its own angle: between the face's root edge and the root cylinder it leaves
+a fillet at most F high (``root_fillet``, in the program's header), as a
+groove's bottom corners keep one. Lowering the tip to √(b² − a²) would cut
+it, and gouge the floor under the cutter's axis by as much.
 """
 
 from __future__ import annotations
@@ -66,10 +106,21 @@ from scipy.spatial import cKDTree
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import DesignError
-from camcad.geometry.barrel import BarrelFollower, BarrelKind, BarrelOptions, RollerShape
+from camcad.extremes import extremes_rows
+from camcad.geometry.barrel import (
+    BarrelFollower,
+    BarrelKind,
+    BarrelOptions,
+    OscillatingBarrelRoller,
+    RibRoller,
+    RollerShape,
+    TranslatingBarrelRoller,
+    barrel_faces,
+    rib_rollers,
+)
 from camcad.geometry.barrel_limits import developed_walls
 from camcad.knobs import Knob
-from camcad.motion.program import MotionProgram
+from camcad.motion.program import MotionProgram, Side
 
 __all__ = [
     "BarrelPass",
@@ -117,7 +168,11 @@ class BarrelPass:
     the upper wall); ``tool`` its number, ``radius`` its cutter radius at the
     tip [mm] and ``taper`` its flank's dr/dt (0 for a flat end mill: radius
     + taper·(t − z) at station t ≥ z); ``deviation``: the axis's largest
-    distance from the exact path between blocks [mm].
+    distance from the exact path between blocks [mm]. A rib's passes follow
+    one of its rollers (:func:`~camcad.geometry.barrel.rib_rollers`):
+    ``roller`` its offset h [mm] (0: the follower's own roller, a groove's
+    pitch path), and ``slide`` [mm] moves the shifted path along the
+    barrel's axis (+z); ``shift`` is then from that roller's path.
     """
 
     kind: str
@@ -130,6 +185,8 @@ class BarrelPass:
     a: FloatArray
     deviation: float
     taper: float = 0.0
+    roller: float = 0.0
+    slide: float = 0.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -139,13 +196,22 @@ class BarrelToolpath:
     ``small_cutter`` (2, 2, 2) [mm]: what finishing the walls with the roughing
     cutter instead would leave (:func:`small_cutter_deviation`) at the
     groove's bottom and top (rows), upper and lower wall, (least, greatest);
-    NaN for a conical roller (its finishing cutter is tapered, not smaller).
+    a rib: at its root and top, its upper and lower face; NaN for a conical
+    roller (its finishing cutter is tapered, not smaller). ``root_fillet``
+    [mm]: a rib's faces at the root station b stand up to this far outside
+    the root cylinder, the most a flat end leaves beside them there (module
+    notes); ``floor_rise`` [mm]: how far above the root a rib's floor stays
+    where a roughing cutter's axis runs more than its radius off the
+    barrel's axis (an arm), √(b² + (|y| − r_c)²) − b at the largest |y|;
+    both 0 for a groove.
     """
 
     passes: tuple[BarrelPass, ...]
     options: BarrelToolpathOptions
     barrel: BarrelOptions
     small_cutter: FloatArray
+    root_fillet: float = 0.0
+    floor_rise: float = 0.0
 
     @property
     def max_deviation(self) -> float:
@@ -205,23 +271,57 @@ def _pass(
     y, zz = _path(program, follower, options, phi, shift)
     x, yy, a = zz.copy(), -y, -np.degrees(phi)
     readonly(x, yy, a)
+    roller = follower.offset if isinstance(follower, RibRoller) else 0.0
     return BarrelPass(
-        kind=kind, shift=shift, tool=tool, radius=radius, z=z, x=x, y=yy, a=a, deviation=gap, taper=taper
+        kind=kind,
+        shift=shift,
+        tool=tool,
+        radius=radius,
+        z=z,
+        x=x,
+        y=yy,
+        a=a,
+        deviation=gap,
+        taper=taper,
+        roller=roller,
+    )
+
+
+def _slid(base: BarrelPass, slide: float, z: float) -> BarrelPass:
+    """``base`` moved by ``slide`` [mm] along the barrel's axis (machine X), its tip at ``z``.
+
+    The same blocks: a translation keeps every chord's distance from the
+    (translated) exact path, so the deviation is the base pass's.
+    """
+    x = base.x + slide
+    readonly(x)
+    return BarrelPass(
+        kind=base.kind,
+        shift=base.shift,
+        tool=base.tool,
+        radius=base.radius,
+        z=z,
+        x=x,
+        y=base.y,
+        a=base.a,
+        deviation=base.deviation,
+        roller=base.roller,
+        slide=base.slide + slide,
     )
 
 
 def plan_barrel(
     program: MotionProgram, follower: BarrelFollower, options: BarrelOptions, spec: BarrelToolpathOptions
 ) -> BarrelToolpath:
-    """Rough and finish passes for the groove (module notes).
+    """Rough and finish passes for the groove, or for the barrel round a rib (module notes).
 
     Raises
     ------
     DesignError
-        ``gcode.rough_diameter`` not smaller than the groove is wide less
-        twice the stock; ``gcode.step_down``, ``gcode.stepover``,
-        ``gcode.stock``, ``gcode.tolerance`` not positive; ``cam.style`` a
-        rib (module notes).
+        ``gcode.rough_diameter`` not smaller than the groove is wide (a rib:
+        the gap its roller runs in, 2r_f + c) less twice the stock;
+        ``gcode.step_down``, ``gcode.stepover``, ``gcode.stock``,
+        ``gcode.tolerance`` not positive; ``gcode.stepover`` above 1.
     """
     for path, value in (
         (Knob.GCODE_TOLERANCE, spec.tolerance),
@@ -231,14 +331,19 @@ def plan_barrel(
     ):
         if not (math.isfinite(value) and value > 0.0):
             raise DesignError(path, f"{value!r} is not allowed; give a number > 0")
-    if options.kind is BarrelKind.RIB:
+    if spec.stepover > 1.0:
         raise DesignError(
-            Knob.CAM_STYLE,
-            '"barrel-rib": the 4-axis program machines a groove; a rib\'s barrel is not planned yet',
+            Knob.STEPOVER,
+            f"{spec.stepover!r} is not allowed: passes farther apart than the cutter's diameter leave "
+            "ridges; give 0 < stepover ≤ 1",
         )
     cone = options.roller is RollerShape.CONICAL
     if not (math.isfinite(spec.stock) and spec.stock >= 0.0):
         raise DesignError(Knob.STOCK, f"{spec.stock!r} mm is not allowed; give 0 mm or more")
+    if options.kind is BarrelKind.RIB:
+        if isinstance(follower, RibRoller):
+            raise ValueError("plan a rib with its follower, not one of its rollers")
+        return _plan_rib(program, follower, options, spec)
     # a cone: rough as for the cylinder of its wall's radius at the bottom (module notes)
     r_w = (
         float(options.roller_at(options.bottom_radius, clearance=True))
@@ -312,6 +417,97 @@ def plan_barrel(
     return BarrelToolpath(passes=tuple(passes), options=spec, barrel=options, small_cutter=small)
 
 
+def _plan_rib(
+    program: MotionProgram,
+    follower: TranslatingBarrelRoller | OscillatingBarrelRoller,
+    options: BarrelOptions,
+    spec: BarrelToolpathOptions,
+) -> BarrelToolpath:
+    """The barrel round a rib: each side roughed from its roller's path outwards, each face finished."""
+    r_w = options.roller_radius + 0.5 * options.clearance
+    r_c = 0.5 * spec.rough_diameter
+    reach = r_w - r_c - spec.stock
+    if reach < 0.0:
+        raise DesignError(
+            Knob.ROUGH_DIAMETER,
+            f"{spec.rough_diameter:g} mm does not fit the gap {2 * r_w:g} mm wide each roller runs in "
+            f"beside the rib with {spec.stock:g} mm stock on its face; "
+            f"give rough_diameter ≤ {2 * (r_w - spec.stock):g} mm",
+        )
+    step = spec.stepover * spec.rough_diameter
+    bottom = options.bottom_radius
+    levels = np.arange(options.barrel_radius - spec.step_down, bottom, -spec.step_down)
+    levels = np.r_[levels[levels > bottom], bottom]  # the floor round the rib: cut to the root
+    up, low = rib_rollers(follower, options)
+    near = np.linspace(0.0, reach, max(1, math.ceil(reach / step) + 1)) if reach > 0.0 else np.zeros(1)
+    sides: list[list[BarrelPass]] = []
+    for roller, away in ((up, 1.0), (low, -1.0)):  # +1: the side above the rib, away from it is +z
+        # near the face: shifts towards the rib out to the roller's own path (the last, shift 0)
+        base = [
+            _pass(
+                program,
+                roller,
+                options,
+                kind="rough",
+                tool=spec.rough_tool,
+                radius=r_c,
+                z=bottom,
+                shift=float(-away * d) + 0.0,  # + 0.0: no −0.0
+                tolerance=spec.tolerance,
+            )
+            for d in near[::-1]
+        ]
+        path = base[-1]
+        # then the roller's path slid away from the rib until the cutter's axis is past the end all round
+        far = (options.length - float(path.x.min())) if away > 0 else float(path.x.max())
+        count = max(0, math.ceil(far / step)) if far > 0.0 else 0
+        slides = [away * far * (k + 1) / count for k in range(count)]
+        sides.append(base + [_slid(path, d, bottom) for d in slides])
+    passes = [_slid(p, 0.0, float(level)) for level in levels for side in sides for p in side]
+    half_c = 0.5 * options.clearance
+    passes += [
+        _pass(
+            program,
+            roller,
+            options,
+            kind=f"finish {name}",
+            tool=spec.finish_tool,
+            radius=options.roller_radius,
+            z=bottom,
+            shift=-away * half_c,  # towards the rib: the cutter's edge r_f + c/2 off the path
+            tolerance=spec.tolerance,
+        )
+        for name, roller, away in (("upper", up, 1.0), ("lower", low, -1.0))
+    ]
+    # the upper face is the +h roller's lower wall, the lower face the −h roller's upper wall
+    stations = np.array([bottom, options.barrel_radius])
+    upper = small_cutter_deviation(program, up, options, r_c, stations, walls=(1,))
+    lower = small_cutter_deviation(program, low, options, r_c, stations, walls=(0,))
+    small = np.stack((upper[:, 1], lower[:, 0]), axis=1)
+    readonly(small)
+
+    # the faces' root edges: their largest radius over the turn, a true extreme (one-sided at joints)
+    def edges(phi: FloatArray, side: Side) -> FloatArray:
+        faces = barrel_faces(program.evaluate(phi, side=side), follower, options, stations[:1])
+        out: FloatArray = np.vstack(
+            [np.hypot(f.point[:, 0, 0], f.point[:, 0, 1]) for f in (faces.upper, faces.lower)]
+        )
+        return out
+
+    joints = [bp.phi for bp in program.breakpoints]
+    found = extremes_rows(edges, program.sample_phi(math.radians(0.5)), joints, ("max", "max"))
+    edge = max(e.value for e in found)
+    off = max(0.0, max(float(np.abs(p.y).max()) for p in passes if p.kind == "rough") - r_c)
+    return BarrelToolpath(
+        passes=tuple(passes),
+        options=spec,
+        barrel=options,
+        small_cutter=small,
+        root_fillet=edge - bottom,
+        floor_rise=math.hypot(bottom, off) - bottom,
+    )
+
+
 def _nearest_on_path(points: FloatArray, path: FloatArray, param: FloatArray, idx: np.ndarray) -> FloatArray:
     """Distance (n,) from points to a sampled smooth path near its samples ``idx``, by a 3-point parabola.
 
@@ -342,6 +538,7 @@ def small_cutter_deviation(
     stations: FloatArray,
     *,
     step: float = math.radians(0.05),
+    walls: tuple[int, ...] = (0, 1),
 ) -> FloatArray:
     """How far a wall cut by a smaller cutter lies from the exact wall, at stations t [mm].
 
@@ -360,6 +557,9 @@ def small_cutter_deviation(
     r_c, tan β = s′/t (the cutter's axis is δ off the path along the pitch
     station's normal, δ·cos Δβ along the wall's at station t).
 
+    ``walls``: which to measure, 0 the upper and 1 the lower (the other's
+    row is NaN); a rib's face is one wall of one of its rollers.
+
     Returns
     -------
     FloatArray
@@ -369,10 +569,12 @@ def small_cutter_deviation(
     r_w = options.roller_radius + 0.5 * options.clearance
     phi = program.sample_phi(step)
     motion = program.evaluate(phi)
-    out = np.zeros((len(stations), 2, 2))
+    out = np.full((len(stations), 2, 2), np.nan)
     for i, t in enumerate(np.asarray(stations, dtype=float)):
-        walls = developed_walls(motion, follower, options, float(t))
-        for j, (sign, wall) in enumerate(((1.0, walls.upper.point), (-1.0, walls.lower.point))):
+        developed = developed_walls(motion, follower, options, float(t))
+        for j, (sign, wall) in enumerate(((1.0, developed.upper.point), (-1.0, developed.lower.point))):
+            if j not in walls:
+                continue
             y, z = _path(program, follower, options, phi, sign * (r_w - cutter_radius))
             centres = np.column_stack((t * phi + y, z))
             period = np.array([t * math.tau, 0.0])

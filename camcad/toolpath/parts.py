@@ -1,8 +1,8 @@
 """The tool path of one part of a cam family, by its shape and the machine.
 
 A part with a :class:`~camcad.geometry.families.Barrel` is a barrel cam: its
-groove roughed and its walls finished on a 4-axis machine
-(:func:`camcad.toolpath.barrel.plan_barrel`). A part with a
+groove (or the barrel round its rib) roughed and its walls (the rib's faces)
+finished on a 4-axis machine (:func:`camcad.toolpath.barrel.plan_barrel`). A part with a
 :class:`~camcad.geometry.families.Pocket` is a groove: slot and flank
 passes (:func:`camcad.toolpath.groove.plan_groove`); a plate is cut along
 its outline, on a three-axis mill (:func:`camcad.toolpath.plan_toolpath`)
@@ -15,6 +15,7 @@ import math
 from typing import TYPE_CHECKING
 
 from camcad.errors import DesignError
+from camcad.geometry.barrel import BarrelKind
 from camcad.geometry.families import Barrel, Part
 from camcad.knobs import Knob
 from camcad.toolpath.bar import plan_bar
@@ -36,8 +37,8 @@ def barrel_toolpath_options(barrel: Barrel, spec: GcodeSpec) -> BarrelToolpathOp
 
     Without a stated ``tool_diameter`` the roughing cutter is the largest
     half-millimetre size within :data:`ROUGH_SHARE` of the groove's width
-    less the stock on both walls; ``tool_number`` roughs and the next
-    number finishes.
+    (a rib: the gap 2r_f + c each roller runs in) less the stock on both
+    walls; ``tool_number`` roughs and the next number finishes.
 
     Raises
     ------
@@ -53,9 +54,10 @@ def barrel_toolpath_options(barrel: Barrel, spec: GcodeSpec) -> BarrelToolpathOp
     else:
         rough = spec.tool_diameter
     if rough > room:
+        what = "the gap beside the rib" if o.kind is BarrelKind.RIB else "the groove"
         raise DesignError(
             Knob.TOOL_DIAMETER,
-            f"{rough:g} mm does not fit the groove {2 * o.roller_radius + o.clearance:g} mm wide with "
+            f"{rough:g} mm does not fit {what} {2 * o.roller_radius + o.clearance:g} mm wide with "
             f"{spec.stock_to_leave:g} mm stock on each wall; allowed: ≤ {room:g} mm",
         )
     return BarrelToolpathOptions(

@@ -102,7 +102,7 @@ def test_figures_equal_those_camcad_check_prints(path, capsys):
     fit = rows["fit control points"]
     assert fit == f"{result.fit_control_points} (max error {result.fit_max_error.value * 1000:.3f} µm)"
     # every limit the API finds, the check finds too (the check also plans the toolpath: gouge)
-    # (a note is no limit: a rib's barrel has no program)
+    # (a note is no limit)
     assert {f.message for f in result.findings if f.severity.value != "note"} <= set(limits)
     assert (code == 0) == (not limits)
 

@@ -101,13 +101,20 @@ def require(program: str) -> str:
 
 
 def run(args: list[str], *, cwd: Path, timeout: float = PROGRAM_TIMEOUT) -> subprocess.CompletedProcess[str]:
-    """Run a program headless under ``timeout``; its config and runtime dirs go to ``cwd``."""
+    """Run a program headless under ``timeout``; its config and runtime dirs go to ``cwd``.
+
+    rs274 gets ``cwd`` as its home too: it keeps its tool table in ``$HOME/.tool.mmap``, which
+    another rs274 running at the same time (another test session) would overwrite under it
+    ("Requested tool 2 not found in the tool table").
+    """
     env = dict(os.environ)
     env.update(
         QT_QPA_PLATFORM="offscreen",
         XDG_RUNTIME_DIR=str(cwd),
         XDG_CONFIG_HOME=str(cwd / ".config"),
     )
+    if Path(args[0]).name == "rs274":
+        env["HOME"] = str(cwd)
     timeout_cmd = shutil.which("timeout")
     prefix = [timeout_cmd, "--kill-after=10", str(int(timeout))] if timeout_cmd else []
     return subprocess.run(

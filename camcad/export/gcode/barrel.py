@@ -6,7 +6,9 @@ to its Z (G94, ``plunge_feed``), one revolution of ``G1 X… Y… A… F…`` bl
 G93 (F = 1/T, T the block's time in minutes for ``feed`` mm/min of the tool
 axis's path on the barrel's surface), back to G94 and a retract. A passes
 unwind (A runs 0 → −360 in every pass, the way back being a rapid at the
-clearance height). LinuxCNC dialect (G-code that its ``rs274`` reads).
+clearance height). LinuxCNC dialect (G-code that its ``rs274`` reads). A rib's program
+(:func:`camcad.toolpath.barrel.plan_barrel`, module notes) is written the
+same way; its header names the rib and its faces.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import numpy as np
 
 from camcad.export.gcode.rotary import inverse_feed_text
 from camcad.export.gcode.writer import comment_text
+from camcad.geometry.barrel import BarrelKind
 
 if TYPE_CHECKING:
     from camcad.toolpath.barrel import BarrelToolpath
@@ -51,6 +54,27 @@ def render_barrel_program(toolpath: BarrelToolpath, *, name: str = "barrel cam")
             f"radius grows {finish.taper:.6f}/mm up the tool: the conical roller's taper (apex on the axis)",
             "the tapered cutter follows the roller's own path: one pass cuts both walls",
         ]
+    elif o.kind is BarrelKind.RIB:
+        head[-1:-1] = [
+            f"rib: {o.rib_width:g} wide, top Z{o.barrel_radius:.4f}; the barrel round it is cut to its root "
+            f"Z{o.bottom_radius:.4f} over X0 to X{o.length:g}",
+            f"finish: T{s.finish_tool} flat end mill D{2 * o.roller_radius:.3f} (the rollers' diameter) "
+            "along each face's roller's own path, one pass per face",
+        ]
+        head.append(
+            f"a face finished with T{s.rough_tool} instead (exact at the pitch station) would be off by "
+            f"up to {float(abs(toolpath.small_cutter[0]).max()):.4f} at the rib's root and "
+            f"{float(abs(toolpath.small_cutter[1]).max()):.4f} at its top"
+        )
+        head.append(
+            f"the flat ends leave a fillet up to {toolpath.root_fillet:.4f} high at the rib's root beside "
+            "its flanks, where the faces' root edges stand off the root cylinder"
+        )
+        if toolpath.floor_rise > 0.0:
+            head.append(
+                f"the floor round the rib stays up to {toolpath.floor_rise:.4f} above the root where the "
+                f"roughing cutter's axis runs more than its radius off the barrel's axis [Y]"
+            )
     else:
         head[-1:-1] = [
             f"finish: T{s.finish_tool} flat end mill D{2 * o.roller_radius:.3f} (the roller's diameter) "

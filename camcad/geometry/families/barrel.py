@@ -31,9 +31,9 @@ translating follower each roller's developed pitch line is the follower's
 moved by ±h along the barrel's axis, with the same pressure angle and
 curvature: the developed cam, its positive drive and its flanks are the
 groove's (for an arm the pressure angle is the larger of the two rollers'
-and the lever the roller's, √(l² + h²)). A rib's barrel gets no ``cam.ngc``
-(the 4-axis plan machines a groove; a rib needs the barrel's whole surface
-round it cut away), which a note says.
+and the lever the roller's, √(l² + h²)). A rib's ``cam.ngc`` cuts the
+barrel's whole surface round the rib down to its root and finishes each
+face along its roller's path (:mod:`camcad.toolpath.barrel`, module notes).
 """
 
 from __future__ import annotations
@@ -48,7 +48,6 @@ import numpy as np
 from camcad._typing import ArrayLike, FloatArray, readonly
 from camcad.errors import DesignError
 from camcad.extremes import SIDE_WORDS, Extreme, extremes_rows
-from camcad.findings import Finding, Severity
 from camcad.geometry.barrel import (
     BarrelFollower,
     BarrelKind,
@@ -244,10 +243,7 @@ class BarrelFamily:
             barrel_follower=barrel.follower,
             barrel_options=barrel.options,
         )
-        # a rib's barrel has no 4-axis program (module notes): the part says so and has none planned
-        unplanned = _RIB_UNPLANNED if self.rib else None
-        check = _BarrelCheck(barrel, unplanned)
-        return (Part(cam=developed, barrel=barrel, checks=(check,), program=not self.rib),)
+        return (Part(cam=developed, barrel=barrel, checks=(_BarrelCheck(barrel),)),)
 
     def drive(self, roller_radius: float, options: FamilyOptions) -> Drive:
         """The groove's two walls (a rib's two faces) drive the roller(s) both ways, with the play c."""
@@ -281,29 +277,15 @@ class BarrelFamily:
         return " The roller runs in the groove round the barrel, shown developed at its pitch station."
 
 
-_RIB_UNPLANNED = Finding(
-    kind="no program",
-    severity=Severity.NOTE,
-    field="cam.style",
-    message=(
-        'cam.style: "barrel-rib" gets no cam.ngc: the 4-axis program machines a groove, and a rib needs '
-        "the barrel's whole surface round it cut away, which is not planned; "
-        "cam.step, cam.stl and profile.dxf are written"
-    ),
-)
-
-
 @dataclass(frozen=True, slots=True)
 class _BarrelCheck:
     """The barrel's own findings (a wall that loops at the groove's bottom)."""
 
     barrel: Barrel
-    unplanned: Finding | None = None  # a note: why the part has no G-code program
 
     @property
     def findings(self) -> tuple[Any, ...]:
-        note = () if self.unplanned is None else (self.unplanned,)
-        return (*self.barrel.limits.findings, *note)
+        return self.barrel.limits.findings
 
     @property
     def radius_margin(self) -> float:

@@ -205,8 +205,8 @@ class Part:
     checks
         The family's own checks of the part (a groove's flank checks).
     program
-        False for a part made without a G-code program (a rib's barrel): no
-        ``cam.ngc`` is planned; its checks carry a note saying why.
+        False for a part made without a G-code program: no ``cam.ngc`` is
+        planned; its checks carry a note saying why (no family needs it now).
     """
 
     cam: Cam
