@@ -10,7 +10,7 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, LineElement, PointElement
-from camcad.geometry.followers._arm import arm_swing, pivot_problem
+from camcad.geometry.followers._arm import arm_swing, per_angle, pivot_problem
 from camcad.geometry.followers.base import (
     ARM_LIFT,
     FACE_MARGIN,
@@ -67,6 +67,12 @@ class OscillatingFlat:
         return (math.sqrt(max(self.pivot_distance**2 - y * y, 0.0)), y)
 
     @property
+    def pivot_angle(self) -> float:
+        """γ [rad]: the pivot's polar angle about the cam axis."""
+        px, py = self.pivot
+        return math.atan2(py, px)
+
+    @property
     def arm_direction(self) -> float:
         """The arm's direction at ψ = 0, machine frame [rad]: along the face towards the cam (−x)."""
         return math.pi
@@ -79,9 +85,8 @@ class OscillatingFlat:
     def _line(self, motion: Motion) -> tuple[FloatArray, tuple[FloatArray, ...], tuple[FloatArray, ...]]:
         """n(θ), (θ, θ′, θ″, θ‴) and (p, p′, p″, p‴)."""
         psi, d1, d2, d3 = arm_swing(motion)
-        px, py = self.pivot
         d = self.pivot_distance
-        u = math.pi / 2.0 - psi - math.atan2(py, px)  # θ − γ
+        u = math.pi / 2.0 - psi - self.pivot_angle  # θ − γ
         t1, t2, t3 = -d1, -d2, -d3
         cu, su = np.cos(u), np.sin(u)
         p0 = d * cu - self.face_offset
@@ -119,7 +124,7 @@ class OscillatingFlat:
         """The pivot's foot on the face, P − f·n, and the unit face direction from it towards the cam."""
         n, _, (p0, _, _, _) = self._line(motion)
         pivot = np.asarray(self.pivot)
-        foot = pivot - self.face_offset * n
+        foot = pivot - per_angle(self.face_offset) * n
         along = p0[:, None] * n - foot
         return foot, along / np.hypot(along[:, 0], along[:, 1])[:, None]
 

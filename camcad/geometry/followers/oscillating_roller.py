@@ -69,6 +69,12 @@ class OscillatingRoller:
         return math.acos(max(-1.0, min(1.0, (d * d + arm * arm - r0 * r0) / (2.0 * d * arm))))
 
     @property
+    def cam_direction(self) -> float:
+        """γ [rad]: the direction from the pivot to the cam axis, machine frame."""
+        px, py = self.pivot
+        return math.atan2(-py, -px)
+
+    @property
     def arm_direction(self) -> float:
         """The arm's direction pivot → roller centre at ψ = 0, machine frame [rad]."""
         px, py = self.pivot
@@ -86,11 +92,9 @@ class OscillatingRoller:
 
     def element(self, motion: Motion) -> PointElement:
         """The roller centre P + l·e(θ), θ = γ − β0 − ψ with γ the direction pivot → cam axis."""
-        px, py = self.pivot
-        gamma = math.atan2(-py, -px)
         psi, d1, d2, d3 = arm_swing(motion)
         return turning_point(
-            self.pivot, self.arm_length, (gamma - self.initial_arm_angle - psi, -d1, -d2, -d3)
+            self.pivot, self.arm_length, (self.cam_direction - self.initial_arm_angle - psi, -d1, -d2, -d3)
         )
 
     def trace(self, motion: Motion) -> PointElement:
