@@ -14,7 +14,7 @@ from camcad.motion.program import Motion
 if TYPE_CHECKING:
     from camcad.geometry.spec import FollowerSpec
 
-__all__ = ["arm_swing", "per_angle", "pivot_problem", "turning_point"]
+__all__ = ["arm_swing", "per_angle", "pivot_problem", "turning_centre", "turning_point"]
 
 
 def pivot_problem(spec: FollowerSpec, base_radius: float) -> tuple[str, str] | None:
@@ -71,8 +71,20 @@ def turning_point(
     je = np.column_stack((-e[:, 1], e[:, 0]))
     length = per_angle(length)
     return PointElement(
-        m0=np.asarray(pivot, dtype=float) + length * e,
+        m0=_turned(pivot, length, e),
         m1=length * t1[:, None] * je,
         m2=length * (t2[:, None] * je - (t1**2)[:, None] * e),
         m3=length * ((t3 - t1**3)[:, None] * je - (3.0 * t1 * t2)[:, None] * e),
     )
+
+
+def turning_centre(
+    pivot: tuple[float, float] | FloatArray, length: float | FloatArray, theta: FloatArray
+) -> FloatArray:
+    """(n, 2) the point P + l·e(θ) alone [mm]: :func:`turning_point`'s ``m0``, the same bits."""
+    return _turned(pivot, per_angle(length), np.column_stack((np.cos(theta), np.sin(theta))))
+
+
+def _turned(pivot: tuple[float, float] | FloatArray, length: float | FloatArray, e: FloatArray) -> FloatArray:
+    out: FloatArray = np.asarray(pivot, dtype=float) + length * e
+    return out

@@ -10,7 +10,7 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, PointElement
-from camcad.geometry.followers._arm import arm_swing, pivot_problem, turning_point
+from camcad.geometry.followers._arm import arm_swing, pivot_problem, turning_centre, turning_point
 from camcad.geometry.followers.base import (
     ARM_LIFT,
     PIVOT_DISTANCE,
@@ -93,9 +93,12 @@ class OscillatingRoller:
     def element(self, motion: Motion) -> PointElement:
         """The roller centre P + l·e(θ), θ = γ − β0 − ψ with γ the direction pivot → cam axis."""
         psi, d1, d2, d3 = arm_swing(motion)
-        return turning_point(
-            self.pivot, self.arm_length, (self.cam_direction - self.initial_arm_angle - psi, -d1, -d2, -d3)
-        )
+        return turning_point(self.pivot, self.arm_length, (self._theta(psi), -d1, -d2, -d3))
+
+    def _theta(self, psi: FloatArray) -> FloatArray:
+        """θ = γ − β0 − ψ [rad]: the arm's direction pivot → roller centre at arm swing ψ [rad]."""
+        out: FloatArray = self.cam_direction - self.initial_arm_angle - psi
+        return out
 
     def trace(self, motion: Motion) -> PointElement:
         """The roller centre: the element itself."""
@@ -110,7 +113,7 @@ class OscillatingRoller:
 
     def contact_position(self, contact: FloatArray, motion: Motion) -> FloatArray:
         """The contact's signed distance from the arm's line [mm] (r_f·sin α; + to the arm's left)."""
-        centre = self.element(motion).m0
+        centre = turning_centre(self.pivot, self.arm_length, self._theta(arm_swing(motion)[0]))
         arm = centre - np.asarray(self.pivot)
         unit = arm / np.hypot(arm[:, 0], arm[:, 1])[:, None]
         rel = contact - centre
