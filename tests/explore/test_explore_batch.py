@@ -76,7 +76,7 @@ KINDS: dict[str, tuple[Any, tuple[str, ...], bool]] = {
     ),
     # the families: a groove is one part (its flanks' loads and stresses among the searched rows); a
     # conjugate pair has two plates and a linear cam an open profile: both analysed one by one
-    "groove": (lambda: sample_data("groove_rocker"), ("speed_rpm", "arm_inertia"), True),
+    "groove": (lambda: sample_data("groove_rocker"), ("base_radius", "speed_rpm", "arm_inertia"), True),
     "conjugate pair": (lambda: sample_data("indexing_conjugate"), ("speed_rpm",), False),
     "linear cam": (lambda: sample_data("linear_cam"), ("speed_rpm",), False),
 }
