@@ -103,18 +103,23 @@ def _equal(values: Sequence[Any]) -> bool:
         return False
 
 
+def _number(value: Any) -> bool:
+    return isinstance(value, (float, int)) and not isinstance(value, bool)
+
+
 def _numbers(values: Sequence[Any]) -> bool:
-    """Whether the values are all numbers, or all tuples of as many numbers (a point): one array row each."""
+    """Whether the values are all numbers: one array element each."""
+    return all(_number(v) for v in values)
 
-    def number(v: Any) -> bool:
-        return isinstance(v, (float, int)) and not isinstance(v, bool)
 
-    if all(number(v) for v in values):
-        return True
+def _tuples(values: Sequence[Any]) -> bool:
+    """Whether the values are all tuples of as many numbers (a point, two offsets): one array row each."""
     first = values[0]
-    return all(
-        isinstance(v, tuple) and len(v) == len(first) and all(number(x) for x in v) for v in values
-    ) and bool(first)
+    return (
+        isinstance(first, tuple)
+        and bool(first)
+        and all(isinstance(v, tuple) and len(v) == len(first) and all(_number(x) for x in v) for v in values)
+    )
 
 
 class _FollowerStack:
@@ -149,10 +154,10 @@ class _FollowerStack:
                         continue
                     if _equal(values):
                         self.constant[name] = values[0]
-                    elif _numbers(values):
+                    elif _numbers(values) or _tuples(values):  # the pivot: (V, 2), an (m, 2) array at angles
                         self.varying[name] = np.array(values, dtype=float)
                     elif is_dataclass(values[0]):
-                        self.nested[name] = _Stacked.of(values)
+                        self.nested[name] = _Stacked.of(values, points=True)
                     else:
                         raise _Unsupported(f"the follower's {name} differs between the variants")
                 elif isinstance(obj, (types.FunctionType, staticmethod, classmethod)):
@@ -175,21 +180,28 @@ class _Stacked:
     """Many frozen dataclasses of one type as one: a differing number becomes one value per stacked angle.
 
     ``varying`` holds each differing numeric field's values over the variants
-    (V,) (a point's, such as a guide's pivot: (V, 2)), ``nested`` the differing
-    dataclass fields; equal fields are the first object's. A differing field
-    of another type is :class:`_Unsupported`.
+    (V,), ``tuples`` each differing tuple-of-numbers field's (V, k), ``nested``
+    the differing dataclass fields; equal fields are the first object's. At
+    the angles a tuple becomes a tuple of k arrays, one value per angle each,
+    so that its items (a groove's flank offsets) index and unpack as the
+    scalar code does; with ``points`` (a follower's guide, whose code reads its
+    pivot as an array) it becomes one (m, k) array. A differing field of
+    another type is :class:`_Unsupported`.
     """
 
     first: Any
     varying: Mapping[str, FloatArray]
+    tuples: Mapping[str, FloatArray]
     nested: Mapping[str, _Stacked]
+    points: bool
 
     @staticmethod
-    def of(objects: Sequence[Any]) -> _Stacked:
+    def of(objects: Sequence[Any], *, points: bool = False) -> _Stacked:
         first = objects[0]
         if not is_dataclass(first) or any(type(o) is not type(first) for o in objects):
             raise _Unsupported("not one dataclass")
         varying: dict[str, FloatArray] = {}
+        tuples: dict[str, FloatArray] = {}
         nested: dict[str, _Stacked] = {}
         for f in fields(first):
             values = [getattr(o, f.name) for o in objects]
@@ -197,17 +209,23 @@ class _Stacked:
                 continue
             if _numbers(values):
                 varying[f.name] = np.array(values, dtype=float)
+            elif _tuples(values):
+                tuples[f.name] = np.array(values, dtype=float)
             elif is_dataclass(values[0]):
-                nested[f.name] = _Stacked.of(values)
+                nested[f.name] = _Stacked.of(values, points=points)
             else:
                 raise _Unsupported(f"{f.name} differs between the variants")
-        return _Stacked(first=first, varying=varying, nested=nested)
+        return _Stacked(first=first, varying=varying, tuples=tuples, nested=nested, points=points)
 
     def at(self, which: np.ndarray) -> Any:
         """The object with each differing number the value of variant ``which[i]`` at stacked angle i."""
         out = copy.copy(self.first)
         for name, values in self.varying.items():
             object.__setattr__(out, name, values[which])  # frozen: set as its own constructor would
+        for name, rows in self.tuples.items():
+            picked = rows[which]
+            value = picked if self.points else tuple(picked[:, j] for j in range(picked.shape[1]))
+            object.__setattr__(out, name, value)
         for name, inner in self.nested.items():
             object.__setattr__(out, name, inner.at(which))
         return out

@@ -12,6 +12,7 @@ bracket finder is checked against a plain transcription of its rule.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from typing import Any
@@ -446,3 +447,51 @@ def test_served_answers_only_the_same_bits() -> None:
         got = extremes_rows(rows, grid, [0.0], ("max", "min"), values=flipped)
         assert got != marker and held.used == 0
         assert got[0].value == pytest.approx(1.0) and got[1].value == pytest.approx(-1.0)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    pairs=st.lists(
+        st.tuples(st.floats(-50, 50), st.floats(-50, 50), st.floats(0.1, 9)), min_size=2, max_size=4
+    ),
+    which=st.lists(st.integers(min_value=0, max_value=3), min_size=1, max_size=6),
+)
+def test_stacked_tuples_index_as_each_variants_own(pairs, which) -> None:
+    """A differing pair (a groove's flank offsets, a guide's pivot) read at the angles is each variant's own.
+
+    Stacked as columns, ``pair[0]`` and ``a, b = pair`` give every angle its
+    variant's items (as the scalar code reads them); stacked as points (a
+    follower's guide), ``np.asarray(pivot)`` is the (m, 2) of its pivots.
+    """
+    from dataclasses import replace
+
+    from camcad.explore.batch import _Stacked
+    from camcad.geometry.envelope import Guide
+
+    setups = [replace(_groove_setup(), flank_offsets=(a, b), contact_length=c) for a, b, c in pairs]
+    picks = np.array([w % len(pairs) for w in which])
+    got = _Stacked.of(setups).at(picks)
+
+    def each(values: list[Any]) -> np.ndarray:
+        return np.array(values, dtype=float)
+
+    def same(a: Any, b: np.ndarray) -> bool:  # a field equal in every variant stays the first's scalar
+        return np.array_equal(np.broadcast_to(np.asarray(a, dtype=float), b.shape), b)
+
+    first, second = got.flank_offsets
+    assert same(got.flank_offsets[0], each([setups[w].flank_offsets[0] for w in picks]))
+    assert same(first, each([setups[w].flank_offsets[0] for w in picks]))
+    assert same(second, each([setups[w].flank_offsets[1] for w in picks]))
+    assert same(got.contact_length, each([setups[w].contact_length for w in picks]))
+    guides = [Guide(pivot=(a, b), turn=-1.0) for a, b, _ in pairs]
+    pivot = _Stacked.of(guides, points=True).at(picks).pivot
+    assert same(pivot, each([guides[w].pivot for w in picks]))
+
+
+@functools.cache
+def _groove_setup() -> Any:
+    """The groove sample's dynamics setup (its flank offsets a pair)."""
+    from camcad.design import load_design
+    from tests.conftest import ROOT
+
+    return load_design(ROOT / "samples" / "groove_rocker.toml").dynamics_setup()
