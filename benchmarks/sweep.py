@@ -83,7 +83,7 @@ BATCH_SAMPLES = (
 
 
 SPEED_SAMPLES = ("packaging_rocker", "rocker_flat")
-"""The arms, whose pivot moves with the base radius (one at a time there): swept in speed instead."""
+"""The arms again, swept in speed (their pivot stays put) besides their base radius (the pivot moves)."""
 
 
 def batch_plan(name: str, designs: int = 64, chunk: int = 16, key: str = "base_radius") -> SweepPlan:

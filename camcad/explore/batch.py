@@ -29,12 +29,14 @@ are analysed together:
 Why the bytes are the same: every step of the search is elementwise per
 row and per bracket, the quantities are the same functions evaluated
 elementwise on the same angles (a parameter as one value per angle instead
-of one scalar gives the same IEEE products and sums), and an analysis takes
-a batch answer only when the samples it computed itself are bit-for-bit the
-ones the batch searched from; any other search runs as usual. Variants of
-another structure, other families (groove, conjugate pair, linear cam), a
-``[vibration]`` table, or a follower whose non-numeric parameters differ
-(an arm's pivot) are analysed one by one (:func:`analyse_one`).
+of one scalar gives the same IEEE products and sums; what a follower derives
+from its parameters with scalar library math, such as an arm's pivot and
+initial angle, is each variant's own property, read on its follower), and an
+analysis takes a batch answer only when the samples it computed itself are
+bit-for-bit the ones the batch searched from; any other search runs as usual.
+Variants of another structure, other families (groove, conjugate pair,
+linear cam), a ``[vibration]`` table, or a follower whose non-numeric
+parameters differ are analysed one by one (:func:`analyse_one`).
 """
 
 from __future__ import annotations
@@ -107,14 +109,35 @@ def _equal(values: Sequence[Any]) -> bool:
         return False
 
 
+def _number(value: Any) -> bool:
+    return isinstance(value, (float, int)) and not isinstance(value, bool)
+
+
+def _numbers(values: Sequence[Any]) -> bool:
+    """Whether the values are all numbers: one array element each."""
+    return all(_number(v) for v in values)
+
+
+def _tuples(values: Sequence[Any]) -> bool:
+    """Whether the values are all tuples of as many numbers (a point, two offsets): one array row each."""
+    first = values[0]
+    return (
+        isinstance(first, tuple)
+        and bool(first)
+        and all(isinstance(v, tuple) and len(v) == len(first) and all(_number(x) for x in v) for v in values)
+    )
+
+
 class _FollowerStack:
     """Many followers of one class as one: each numeric parameter an array, one value per stacked angle.
 
     The follower's own methods (its element, its contact position) run on
     it unchanged; a property is read on every variant's follower (so a
-    derived value such as k = √((r_b + r_f)² − e²) is each variant's own
-    scalar, computed as in a single analysis) and stacked. A non-numeric
-    attribute that differs between the variants (an arm's pivot) is
+    derived value such as k = √((r_b + r_f)² − e²), or an arm's pivot and
+    initial angle, is each variant's own scalar, computed as in a single
+    analysis) and stacked: a number as (V,) values, a point such as the
+    pivot as (V, 2), a dataclass such as the guide as :class:`_Stacked`.
+    Any other attribute that differs between the variants is
     :class:`_Unsupported`.
     """
 
@@ -125,6 +148,7 @@ class _FollowerStack:
         methods: dict[str, Any] = {}
         self.constant: dict[str, Any] = {}
         self.varying: dict[str, FloatArray] = {}
+        self.nested: dict[str, _Stacked] = {}
         for klass in reversed(cls.__mro__[:-1]):
             for name, obj in vars(klass).items():
                 if name.startswith("__"):
@@ -136,8 +160,10 @@ class _FollowerStack:
                         continue
                     if _equal(values):
                         self.constant[name] = values[0]
-                    elif all(isinstance(v, (float, int)) and not isinstance(v, bool) for v in values):
+                    elif _numbers(values) or _tuples(values):  # the pivot: (V, 2), an (m, 2) array at angles
                         self.varying[name] = np.array(values, dtype=float)
+                    elif is_dataclass(values[0]):
+                        self.nested[name] = _Stacked.of(values, points=True)
                     else:
                         raise _Unsupported(f"the follower's {name} differs between the variants")
                 elif isinstance(obj, (types.FunctionType, staticmethod, classmethod)):
@@ -150,6 +176,8 @@ class _FollowerStack:
         view.__dict__.update(self.constant)
         for name, values in self.varying.items():
             setattr(view, name, values[which])
+        for name, inner in self.nested.items():
+            setattr(view, name, inner.at(which))
         return view
 
 
@@ -158,38 +186,52 @@ class _Stacked:
     """Many frozen dataclasses of one type as one: a differing number becomes one value per stacked angle.
 
     ``varying`` holds each differing numeric field's values over the variants
-    (V,), ``nested`` the differing dataclass fields; equal fields are the
-    first object's. A differing field of another type is :class:`_Unsupported`.
+    (V,), ``tuples`` each differing tuple-of-numbers field's (V, k), ``nested``
+    the differing dataclass fields; equal fields are the first object's. At
+    the angles a tuple becomes a tuple of k arrays, one value per angle each,
+    so that its items (a groove's flank offsets) index and unpack as the
+    scalar code does; with ``points`` (a follower's guide, whose code reads its
+    pivot as an array) it becomes one (m, k) array. A differing field of
+    another type is :class:`_Unsupported`.
     """
 
     first: Any
     varying: Mapping[str, FloatArray]
+    tuples: Mapping[str, FloatArray]
     nested: Mapping[str, _Stacked]
+    points: bool
 
     @staticmethod
-    def of(objects: Sequence[Any]) -> _Stacked:
+    def of(objects: Sequence[Any], *, points: bool = False) -> _Stacked:
         first = objects[0]
         if not is_dataclass(first) or any(type(o) is not type(first) for o in objects):
             raise _Unsupported("not one dataclass")
         varying: dict[str, FloatArray] = {}
+        tuples: dict[str, FloatArray] = {}
         nested: dict[str, _Stacked] = {}
         for f in fields(first):
             values = [getattr(o, f.name) for o in objects]
             if _equal(values):
                 continue
-            if all(isinstance(v, (float, int)) and not isinstance(v, bool) for v in values):
+            if _numbers(values):
                 varying[f.name] = np.array(values, dtype=float)
+            elif _tuples(values):
+                tuples[f.name] = np.array(values, dtype=float)
             elif is_dataclass(values[0]):
-                nested[f.name] = _Stacked.of(values)
+                nested[f.name] = _Stacked.of(values, points=points)
             else:
                 raise _Unsupported(f"{f.name} differs between the variants")
-        return _Stacked(first=first, varying=varying, nested=nested)
+        return _Stacked(first=first, varying=varying, tuples=tuples, nested=nested, points=points)
 
     def at(self, which: np.ndarray) -> Any:
         """The object with each differing number the value of variant ``which[i]`` at stacked angle i."""
         out = copy.copy(self.first)
         for name, values in self.varying.items():
             object.__setattr__(out, name, values[which])  # frozen: set as its own constructor would
+        for name, rows in self.tuples.items():
+            picked = rows[which]
+            value = picked if self.points else tuple(picked[:, j] for j in range(picked.shape[1]))
+            object.__setattr__(out, name, value)
         for name, inner in self.nested.items():
             object.__setattr__(out, name, inner.at(which))
         return out
@@ -305,8 +347,8 @@ def _group(designs: list[Design]) -> _Group:
     from camcad.geometry.cam import Cam, follower_from_spec
     from camcad.geometry.families import family_of
 
-    # the followers first: a group whose followers cannot be stacked (an arm's pivot that moves) is
-    # refused before anything else is built
+    # the followers first: a group whose followers cannot be stacked (a non-numeric parameter that
+    # differs) is refused before anything else is built
     _FollowerStack([follower_from_spec(d.follower, d.cam.base_radius) for d in designs])
     first = Cam.from_design(designs[0])
     cams = [first] + [replace(Cam.from_design(d), program=first.program) for d in designs[1:]]

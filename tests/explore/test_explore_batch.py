@@ -12,6 +12,7 @@ bracket finder is checked against a plain transcription of its rule.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from typing import Any
@@ -63,12 +64,20 @@ KINDS: dict[str, tuple[Any, tuple[str, ...], bool]] = {
     ),
     "translating-flat": (lambda: sample_data("hren_tappet"), ("base_radius", "speed_rpm"), True),
     "translating-mushroom": (_mushroom, ("base_radius", "offset", "follower_mass"), True),
-    # an arm's pivot moves with the base radius (not stackable): spring, speed and mass are
-    "oscillating-roller": (lambda: sample_data("packaging_rocker"), ("speed_rpm", "follower_mass"), True),
-    "oscillating-flat": (lambda: sample_data("rocker_flat"), ("speed_rpm",), True),
+    # an arm's pivot and initial angle move with the base radius, the pivot distance, the arm, the roller
+    "oscillating-roller": (
+        lambda: sample_data("packaging_rocker"),
+        ("base_radius", "pivot_distance", "roller_radius", "arm_length", "speed_rpm"),
+        True,
+    ),
+    "oscillating-flat": (
+        lambda: sample_data("rocker_flat"),
+        ("base_radius", "pivot_distance", "face_offset", "speed_rpm"),
+        True,
+    ),
     # the families: a groove is one part (its flanks' loads and stresses among the searched rows); a
     # conjugate pair has two plates and a linear cam an open profile: both analysed one by one
-    "groove": (lambda: sample_data("groove_rocker"), ("speed_rpm", "arm_inertia"), True),
+    "groove": (lambda: sample_data("groove_rocker"), ("base_radius", "speed_rpm", "arm_inertia"), True),
     "conjugate pair": (lambda: sample_data("indexing_conjugate"), ("speed_rpm",), False),
     "linear cam": (lambda: sample_data("linear_cam"), ("speed_rpm",), False),
 }
@@ -77,7 +86,10 @@ _SCALE = st.floats(min_value=0.85, max_value=1.25, allow_nan=False)
 
 
 def _value(data: dict[str, Any], name: str, scale: float) -> float:
-    table = {"base_radius": "cam", "speed_rpm": "cam", "offset": "follower", "roller_radius": "follower"}
+    table = {"base_radius": "cam", "speed_rpm": "cam"}
+    table |= dict.fromkeys(
+        ("offset", "roller_radius", "pivot_distance", "arm_length", "face_offset"), "follower"
+    )
     base = data.get(table.get(name, "dynamics"), {}).get(name)
     if base is None or base == 0:
         base = {"offset": 4.0, "spring_rate": 2.0, "follower_mass": 0.5}.get(name, 1.0)
@@ -102,9 +114,17 @@ def test_batch_rows_equal_one_at_a_time(kind: str, scales: list[list[float]]) ->
     stats = BatchStats()
     got = chunk_rows(data, variables, points, limits=limits, stats=stats)
     assert _text(got) == _text(_one_at_a_time(data, variables, points, limits))
-    if batched:
-        assert stats.batched == len(points), stats  # the batch path ran, not the fall-back
+    valid = sum(not isinstance(_design_or_error(data, variables, values), CamcadError) for values in points)
+    if batched and valid > 1:  # (an arm too short for its pivot is refused by the loader, as alone)
+        assert stats.batched == valid, stats  # the batch path ran, not the fall-back
         assert stats.served == stats.searches > 0, stats  # every search answered by the stacked one
+
+
+def _design_or_error(data: dict[str, Any], variables: list[Any], values: tuple[Any, ...]) -> Any:
+    try:
+        return design_with(data, variables, values)
+    except CamcadError as err:
+        return err
 
 
 def test_sweep_csv_same_bytes_with_batching_on_and_off(tmp_path) -> None:
@@ -133,12 +153,12 @@ def test_sweep_csv_same_bytes_with_batching_on_and_off(tmp_path) -> None:
 
 
 def test_mixed_structures_fall_back_and_match() -> None:
-    """Two laws (two motion structures), a refused variant, an arm whose pivot moves: all in one chunk.
+    """Two laws (two motion structures), a refused variant, an arm and a conjugate pair beside.
 
     The laws form two groups, each analysed together; the refused variant
     (offset beyond r_b + r_f) is its failed row; the rocker's base-radius
-    variants (whose pivot moves) are analysed one by one. Every row is the
-    per-design one.
+    variants (whose pivot moves) are analysed together, the conjugate pair's
+    one by one. Every row is the per-design one.
     """
     data = sample_data("offset_roller")
     variables = [
@@ -166,7 +186,111 @@ def test_mixed_structures_fall_back_and_match() -> None:
     stats = BatchStats()
     got = chunk_rows(rocker, radius, pts, stats=stats)
     assert _text(got) == _text(_one_at_a_time(rocker, radius, pts))
-    assert stats.single == 3 and stats.batched == 0  # the pivot differs: one by one
+    assert stats.single == 0 and stats.batched == 3  # the pivot differs: one stacked follower all the same
+
+    pair = sample_data("indexing_conjugate")
+    radius = [parse_variable("base_radius=40:50", pair, flag="--vary", counted=False)]
+    pts = [(40.0,), (45.0,)]
+    stats = BatchStats()
+    got = chunk_rows(pair, radius, pts, stats=stats)
+    assert _text(got) == _text(_one_at_a_time(pair, radius, pts))
+    assert stats.single == 2 and stats.batched == 0  # two plates: one by one
+
+
+@pytest.mark.parametrize("name", ["packaging_rocker", "rocker_flat"])
+def test_arm_sweep_of_base_radius_and_pivot_batches_every_variant(name: str) -> None:
+    """The sweep benchmark's case for the arms: r_b × d over a grid, one chunk, every variant in the batch.
+
+    The pivot, the initial arm angle and the arm's direction differ from
+    variant to variant; the rows must still be the per-design ones, every
+    byte, and every search answered by the stacked one.
+    """
+    data = sample_data(name)
+    r, d = data["cam"]["base_radius"], data["follower"]["pivot_distance"]
+    variables = [
+        parse_variable(f"base_radius={r!r}:{1.25 * r!r}:3", data, flag="--grid", counted=True),
+        parse_variable(f"pivot_distance={d!r}:{1.2 * d!r}:2", data, flag="--grid", counted=True),
+    ]
+    points = list(grid_points(variables))
+    stats = BatchStats()
+    got = chunk_rows(data, variables, points, stats=stats)
+    assert _text(got) == _text(_one_at_a_time(data, variables, points))
+    assert stats.batched == len(points) == 6 and stats.single == 0, stats
+    assert stats.served == stats.searches > 0, stats
+    assert len({row["pressure_angle_deg"] for row in got}) == 6  # six different cams, not one six times
+
+
+_ARM = st.floats(min_value=0.8, max_value=1.3, allow_nan=False)
+
+
+@settings(max_examples=25, deadline=None)
+@given(params=st.lists(st.tuples(_ARM, _ARM, _ARM, _ARM), min_size=1, max_size=4))
+def test_stacked_arm_followers_give_each_followers_bits(params) -> None:
+    """Arms of random r_b, d, l (or face offset) stacked: element, guide, contact of each, bit for bit.
+
+    The stacked follower runs the follower's own methods with one parameter
+    value per angle; each variant's rows must equal its own follower's
+    output on its angles (the per-design truth), not merely be close.
+    """
+    from camcad.explore.batch import _FollowerStack
+    from camcad.geometry.envelope import PointElement
+    from camcad.geometry.followers import OscillatingFlat, OscillatingRoller
+    from camcad.motion.laws import make_law
+    from camcad.motion.program import MotionProgram
+    from camcad.motion.segments import SegmentKind, SegmentSpec
+
+    program = MotionProgram.from_segments(
+        (
+            SegmentSpec(
+                kind=SegmentKind.RISE, span=math.radians(130.0), lift=15.0, law=make_law("cycloidal")
+            ),
+            SegmentSpec(
+                kind=SegmentKind.RETURN, span=math.radians(130.0), lift=15.0, law=make_law("poly-345")
+            ),
+            SegmentSpec(kind=SegmentKind.DWELL, span=math.radians(100.0)),
+        )
+    )
+    phi = np.linspace(0.0, 2 * math.pi, 37)
+    kinds = [
+        [
+            OscillatingRoller(  # d − l = (c − 0.3)(r_b + r_f): the arm reaches the base circle
+                base_radius=50.0 * a,
+                roller_radius=15.0 * b,
+                pivot_distance=95.0 * e + (c - 0.3) * (50.0 * a + 15.0 * b),
+                arm_length=95.0 * e,
+            )
+            for a, b, c, e in params
+        ],
+        [
+            OscillatingFlat(base_radius=45.0 * a, pivot_distance=140.0 * c, face_offset=10.0 * (b - 1.05))
+            for a, b, c, _ in params
+        ],
+    ]
+    for followers in kinds:
+        nv = len(followers)
+        which = np.repeat(np.arange(nv), phi.size)
+        motion = program.evaluate(np.tile(phi, nv))
+        fol = _FollowerStack(followers).at(which)
+        element = fol.element(motion)
+        contact = np.column_stack((np.cos(motion.phi), np.sin(motion.phi))) * 40.0
+        position = fol.contact_position(contact, motion)
+        trace = fol.trace(motion)
+        driven = fol.guide.driven(trace.m0)
+        for v, alone in enumerate(followers):
+            rows = slice(v * phi.size, (v + 1) * phi.size)
+            mine = program.evaluate(phi)
+            own = alone.element(mine)
+            names = ("m0", "m1", "m2", "m3") if isinstance(own, PointElement) else ("normal", "theta", "p")
+            for name in names:
+                got, want = getattr(element, name), getattr(own, name)
+                if isinstance(want, tuple):
+                    for g, w in zip(got, want, strict=True):
+                        assert np.array_equal(np.asarray(g)[rows], w), name
+                else:
+                    assert np.array_equal(got[rows], want), name
+            assert np.array_equal(position[rows], alone.contact_position(contact[rows], mine))
+            assert np.array_equal(trace.m0[rows], alone.trace(mine).m0)
+            assert np.array_equal(driven[rows], alone.guide.driven(alone.trace(mine).m0))
 
 
 def test_failed_designs_keep_their_place() -> None:
@@ -370,3 +494,51 @@ def test_duty_searches_batched_and_equal(scales: list[list[float]]) -> None:
     assert "film_ratio" in text[0] and "characteristic_values" in text[0]
     assert stats.batched == len(designs), stats
     assert stats.served == stats.searches == 4 * len(designs), stats
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    pairs=st.lists(
+        st.tuples(st.floats(-50, 50), st.floats(-50, 50), st.floats(0.1, 9)), min_size=2, max_size=4
+    ),
+    which=st.lists(st.integers(min_value=0, max_value=3), min_size=1, max_size=6),
+)
+def test_stacked_tuples_index_as_each_variants_own(pairs, which) -> None:
+    """A differing pair (a groove's flank offsets, a guide's pivot) read at the angles is each variant's own.
+
+    Stacked as columns, ``pair[0]`` and ``a, b = pair`` give every angle its
+    variant's items (as the scalar code reads them); stacked as points (a
+    follower's guide), ``np.asarray(pivot)`` is the (m, 2) of its pivots.
+    """
+    from dataclasses import replace
+
+    from camcad.explore.batch import _Stacked
+    from camcad.geometry.envelope import Guide
+
+    setups = [replace(_groove_setup(), flank_offsets=(a, b), contact_length=c) for a, b, c in pairs]
+    picks = np.array([w % len(pairs) for w in which])
+    got = _Stacked.of(setups).at(picks)
+
+    def each(values: list[Any]) -> np.ndarray:
+        return np.array(values, dtype=float)
+
+    def same(a: Any, b: np.ndarray) -> bool:  # a field equal in every variant stays the first's scalar
+        return np.array_equal(np.broadcast_to(np.asarray(a, dtype=float), b.shape), b)
+
+    first, second = got.flank_offsets
+    assert same(got.flank_offsets[0], each([setups[w].flank_offsets[0] for w in picks]))
+    assert same(first, each([setups[w].flank_offsets[0] for w in picks]))
+    assert same(second, each([setups[w].flank_offsets[1] for w in picks]))
+    assert same(got.contact_length, each([setups[w].contact_length for w in picks]))
+    guides = [Guide(pivot=(a, b), turn=-1.0) for a, b, _ in pairs]
+    pivot = _Stacked.of(guides, points=True).at(picks).pivot
+    assert same(pivot, each([guides[w].pivot for w in picks]))
+
+
+@functools.cache
+def _groove_setup() -> Any:
+    """The groove sample's dynamics setup (its flank offsets a pair)."""
+    from camcad.design import load_design
+    from tests.conftest import ROOT
+
+    return load_design(ROOT / "samples" / "groove_rocker.toml").dynamics_setup()

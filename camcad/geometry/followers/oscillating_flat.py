@@ -10,7 +10,7 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, LineElement, PointElement
-from camcad.geometry.followers._arm import arm_swing, pivot_problem
+from camcad.geometry.followers._arm import arm_swing, per_angle, pivot_problem
 from camcad.geometry.followers.base import (
     ARM_LIFT,
     FACE_MARGIN,
@@ -67,6 +67,12 @@ class OscillatingFlat:
         return (math.sqrt(max(self.pivot_distance**2 - y * y, 0.0)), y)
 
     @property
+    def pivot_angle(self) -> float:
+        """γ [rad]: the pivot's polar angle about the cam axis."""
+        px, py = self.pivot
+        return math.atan2(py, px)
+
+    @property
     def arm_direction(self) -> float:
         """The arm's direction at ψ = 0, machine frame [rad]: along the face towards the cam (−x)."""
         return math.pi
@@ -79,17 +85,31 @@ class OscillatingFlat:
     def _line(self, motion: Motion) -> tuple[FloatArray, tuple[FloatArray, ...], tuple[FloatArray, ...]]:
         """n(θ), (θ, θ′, θ″, θ‴) and (p, p′, p″, p‴)."""
         psi, d1, d2, d3 = arm_swing(motion)
-        px, py = self.pivot
         d = self.pivot_distance
-        u = math.pi / 2.0 - psi - math.atan2(py, px)  # θ − γ
+        u = self._from_pivot(psi)
         t1, t2, t3 = -d1, -d2, -d3
         cu, su = np.cos(u), np.sin(u)
-        p0 = d * cu - self.face_offset
+        p0 = self._distance(cu)
         p1 = -d * su * t1
         p2 = -d * cu * t1**2 - d * su * t2
         p3 = d * su * t1**3 - 3.0 * d * cu * t1 * t2 - d * su * t3
-        normal = np.column_stack((np.sin(psi), np.cos(psi)))  # (cos θ, sin θ), exact (0, 1) at ψ = 0
-        return normal, (math.pi / 2.0 - psi, t1, t2, t3), (p0, p1, p2, p3)
+        return self._normal(psi), (math.pi / 2.0 - psi, t1, t2, t3), (p0, p1, p2, p3)
+
+    def _from_pivot(self, psi: FloatArray) -> FloatArray:
+        """θ − γ [rad] at arm swing ψ [rad]."""
+        out: FloatArray = math.pi / 2.0 - psi - self.pivot_angle
+        return out
+
+    def _distance(self, cos_from_pivot: FloatArray) -> FloatArray:
+        """The face line's distance p = d·cos(θ − γ) − f [mm] from the cam axis."""
+        out: FloatArray = self.pivot_distance * cos_from_pivot - self.face_offset
+        return out
+
+    @staticmethod
+    def _normal(psi: FloatArray) -> FloatArray:
+        """(n, 2) n(θ) = (cos θ, sin θ) = (sin ψ, cos ψ): exact (0, 1) at ψ = 0."""
+        out: FloatArray = np.column_stack((np.sin(psi), np.cos(psi)))
+        return out
 
     def element(self, motion: Motion) -> LineElement:
         """The face line n(θ)·x = p with θ = 90° − ψ and p = d·cos(θ − γ) − f, three φ-derivatives."""
@@ -117,9 +137,10 @@ class OscillatingFlat:
 
     def _foot_and_direction(self, motion: Motion) -> tuple[FloatArray, FloatArray]:
         """The pivot's foot on the face, P − f·n, and the unit face direction from it towards the cam."""
-        n, _, (p0, _, _, _) = self._line(motion)
+        psi = arm_swing(motion)[0]  # the line's n and p alone, as _line computes them
+        n, p0 = self._normal(psi), self._distance(np.cos(self._from_pivot(psi)))
         pivot = np.asarray(self.pivot)
-        foot = pivot - self.face_offset * n
+        foot = pivot - per_angle(self.face_offset) * n
         along = p0[:, None] * n - foot
         return foot, along / np.hypot(along[:, 0], along[:, 1])[:, None]
 

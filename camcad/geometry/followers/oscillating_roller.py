@@ -10,7 +10,7 @@ import numpy as np
 
 from camcad._typing import FloatArray
 from camcad.geometry.envelope import Guide, PointElement
-from camcad.geometry.followers._arm import arm_swing, pivot_problem, turning_point
+from camcad.geometry.followers._arm import arm_swing, pivot_problem, turning_centre, turning_point
 from camcad.geometry.followers.base import (
     ARM_LIFT,
     PIVOT_DISTANCE,
@@ -69,6 +69,12 @@ class OscillatingRoller:
         return math.acos(max(-1.0, min(1.0, (d * d + arm * arm - r0 * r0) / (2.0 * d * arm))))
 
     @property
+    def cam_direction(self) -> float:
+        """γ [rad]: the direction from the pivot to the cam axis, machine frame."""
+        px, py = self.pivot
+        return math.atan2(-py, -px)
+
+    @property
     def arm_direction(self) -> float:
         """The arm's direction pivot → roller centre at ψ = 0, machine frame [rad]."""
         px, py = self.pivot
@@ -86,12 +92,13 @@ class OscillatingRoller:
 
     def element(self, motion: Motion) -> PointElement:
         """The roller centre P + l·e(θ), θ = γ − β0 − ψ with γ the direction pivot → cam axis."""
-        px, py = self.pivot
-        gamma = math.atan2(-py, -px)
         psi, d1, d2, d3 = arm_swing(motion)
-        return turning_point(
-            self.pivot, self.arm_length, (gamma - self.initial_arm_angle - psi, -d1, -d2, -d3)
-        )
+        return turning_point(self.pivot, self.arm_length, (self._theta(psi), -d1, -d2, -d3))
+
+    def _theta(self, psi: FloatArray) -> FloatArray:
+        """θ = γ − β0 − ψ [rad]: the arm's direction pivot → roller centre at arm swing ψ [rad]."""
+        out: FloatArray = self.cam_direction - self.initial_arm_angle - psi
+        return out
 
     def trace(self, motion: Motion) -> PointElement:
         """The roller centre: the element itself."""
@@ -106,7 +113,7 @@ class OscillatingRoller:
 
     def contact_position(self, contact: FloatArray, motion: Motion) -> FloatArray:
         """The contact's signed distance from the arm's line [mm] (r_f·sin α; + to the arm's left)."""
-        centre = self.element(motion).m0
+        centre = turning_centre(self.pivot, self.arm_length, self._theta(arm_swing(motion)[0]))
         arm = centre - np.asarray(self.pivot)
         unit = arm / np.hypot(arm[:, 0], arm[:, 1])[:, None]
         rel = contact - centre
