@@ -102,6 +102,8 @@ class ArmLoad:
 
     def axial_force(self, motion: Motion, *, omega: float) -> FloatArray:
         """M = A·ω² + B [N·mm]: the moment about the pivot the cam must supply."""
-        out = self.inertia_coefficient(motion) * omega**2 + self.static_force(motion)
+        out = self.inertia_coefficient(motion) * (omega * omega) + self.static_force(
+            motion
+        )  # ω·ω: see jump.py
         readonly(out)
         return out

@@ -338,7 +338,7 @@ def analyse_drive(
     torque = motor_torque(load, velocity, transmission=k, efficiency=spec.gear_efficiency)
     motor_omega = k * velocity  # rad/s
     if spec.motor_inertia_kg_m2 is not None:
-        eps = k * np.asarray(axis_acceleration, dtype=float) * omega**2  # rad/s²
+        eps = k * np.asarray(axis_acceleration, dtype=float) * (omega * omega)  # rad/s² (ω·ω: see jump.py)
         torque = torque + spec.motor_inertia_kg_m2 * eps
     motor_rpm = np.abs(motor_omega) * _RAD_S_TO_RPM
     w = cycle_weights(p)

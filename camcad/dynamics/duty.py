@@ -514,7 +514,7 @@ def _drive(cam: Cam, dynamics: DynamicsResult, *, setup: DynamicsSetup, spec: Dr
     if spec.mode is DriveMode.CAMSHAFT:
         # the follower's equivalent inertia at the camshaft: I·ψ′² or m·s′² [kg·m²]
         follower = dyn.arm_inertia if arm else dyn.follower_mass
-        equivalent = follower * speed**2 / _MM2_PER_M2
+        equivalent = follower * (speed * speed) / _MM2_PER_M2  # ω·ω: see jump.py
         extremes = None
         if dynamics.torque_min is not None and dynamics.torque_max is not None:
             extremes = (dynamics.torque_min, dynamics.torque_max)

@@ -120,7 +120,7 @@ class FollowerLoad:
         -----
         Quintero & Vanegas (2016), eq. 18 bracket (papers/README erratum).
         """
-        inertia = self.inertia_coefficient(motion) * omega**2  # m s̈, s̈ = a ω²
+        inertia = self.inertia_coefficient(motion) * (omega * omega)  # m s̈, s̈ = a ω² (ω·ω: see jump.py)
         out = inertia + self.static_force(motion)  # Quintero & Vanegas 2016, eq. 18
         readonly(out)
         return out

@@ -80,8 +80,10 @@ def preload_need(
     margin: float = 0.0,
 ) -> FloatArray:
     """(n,) margin·c − A·ω² − (m·g + k·s) [N]: the preload each angle needs; see :func:`min_preload`."""
+    # ω·ω, not ω**2: libm's pow is not always the correctly rounded square (glibc: < 0.52 ulp), so a
+    # scalar ω**2 can differ in the last bit from the same speeds squared as an array in a batch
     out: FloatArray = margin * np.asarray(ratio, dtype=float) - (
-        np.asarray(inertia, dtype=float) * omega**2 + np.asarray(static_without_preload, dtype=float)
+        np.asarray(inertia, dtype=float) * (omega * omega) + np.asarray(static_without_preload, dtype=float)
     )
     return out
 

@@ -66,7 +66,7 @@ class Motion:
         out = TimeMotion(
             phi=self.phi,
             velocity=self.v * omega,
-            acceleration=self.a * omega**2,
+            acceleration=self.a * (omega * omega),  # ω·ω: see dynamics/jump.py
             jerk=self.j * omega**3,
         )
         readonly(out.velocity, out.acceleration, out.jerk)

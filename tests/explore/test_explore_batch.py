@@ -542,3 +542,25 @@ def _groove_setup() -> Any:
     from tests.conftest import ROOT
 
     return load_design(ROOT / "samples" / "groove_rocker.toml").dynamics_setup()
+
+
+def test_a_speed_whose_libm_square_is_off_by_an_ulp_is_still_served() -> None:
+    """ω**2 by libm's pow and ω·ω differ in the last bit at this speed; the batch still serves every search.
+
+    A found case (hypothesis): rocker_flat at 0.9197… of its speed. Were the
+    dynamics to square a scalar ω with ``**`` (pow) while the batch squares
+    the stacked speeds as an array (a product), the samples would differ by
+    an ulp and the variant's search would be run alone.
+    """
+    data = sample_data("rocker_flat")
+    rpm = float(data["cam"]["speed_rpm"]) * 0.9197223816057212
+    omega = rpm * 2.0 * math.pi / 60.0
+    assert omega**2 != omega * omega  # the premise: pow is not the correctly rounded square here
+    variables = [
+        parse_variable(f"speed_rpm={0.85 * rpm!r}:{1.25 * rpm!r}", data, flag="--vary", counted=False)
+    ]
+    points = [(float(data["cam"]["speed_rpm"]),), (rpm,), (1.1 * rpm,)]
+    stats = BatchStats()
+    got = chunk_rows(data, variables, points, limits=(), stats=stats)
+    assert _text(got) == _text(_one_at_a_time(data, variables, points, ()))
+    assert stats.batched == 3 and stats.served == stats.searches > 0, stats
