@@ -48,6 +48,11 @@ def effective_modulus(*, modulus_1: float, poisson_1: float, modulus_2: float, p
     return 1.0 / compliance  # Johnson 1985, §4.2
 
 
+def _is_roller(roller_radius: float | FloatArray | None) -> bool:
+    """Whether r_f is a roller's: not None and not 0 (a batch's per-angle radii, all of one follower)."""
+    return roller_radius is not None and bool(np.all(np.asarray(roller_radius, dtype=float) != 0.0))
+
+
 def contact_curvature(profile_rho: ArrayLike, *, roller_radius: float | None) -> FloatArray:
     """Compute the relative curvature 1/R* of the cam profile and the follower [1/mm].
 
@@ -80,8 +85,8 @@ def contact_curvature(profile_rho: ArrayLike, *, roller_radius: float | None) ->
     rho = np.asarray(profile_rho, dtype=float)
     with np.errstate(divide="ignore"):
         kappa = 1.0 / rho  # 0 where ρ = ±inf, inf at a cusp (ρ = 0)
-    if roller_radius:
-        kappa = kappa + 1.0 / roller_radius  # Johnson 1985, §4.3: 1/R = 1/R1 + 1/R2
+    if _is_roller(roller_radius):
+        kappa = kappa + 1.0 / np.asarray(roller_radius, dtype=float)  # Johnson 1985, §4.3: 1/R = 1/R1 + 1/R2
     out = np.where(kappa > 0.0, kappa, 0.0)
     readonly(out)
     return out
@@ -118,7 +123,7 @@ def driving_curvature(
         (Johnson 1985, §4.3, a concave surface's radius negative).
     """
     rho = np.asarray(profile_rho, dtype=float)
-    roller = roller_radius or None
+    roller = roller_radius if _is_roller(roller_radius) else None
     if flank_offsets is None:
         return contact_curvature(rho, roller_radius=roller)
     inner = contact_curvature(rho + flank_offsets[0], roller_radius=roller)
