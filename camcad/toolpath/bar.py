@@ -18,15 +18,21 @@ from the curve's start on its tangent to its end), fitted within the
 plate's band (``_fit_tolerance`` of :mod:`camcad.toolpath.plan`), rounded to the
 written 4 decimals with each arc's I/J from its rounded start, and measured
 two-way against the exact curve after rounding; the roughing path is the
-finishing arc spline offset by the stock, measured the same way.
+finishing arc spline offset by the stock, measured the same way. Each
+dwell of the motion is a straight stretch of the edge and of its offsets
+(:attr:`~camcad.geometry.cam.Cam.straight_spans`): it is a break node at
+both ends and cut as one line (G1, a LINE in ``profile_arcs.dxf``) between
+them, the arcs beside it ending and starting there on its tangent.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 
+from camcad._typing import FloatArray
 from camcad.angles import TWO_PI
 from camcad.geometry.cam import Cam
 from camcad.geometry.families import Bar
@@ -39,6 +45,7 @@ from camcad.toolpath.spec import Direction, GcodeSpec
 
 __all__ = ["plan_bar"]
 
+_SAME_NODE = 1e-9  # rad: break nodes this close are one
 _NO_REFIT = "the fewest-arcs refit thins closed contours only: the edge keeps the search's arcs"
 
 
@@ -79,16 +86,18 @@ def plan_bar(
         else spec.stock_to_leave
     )
     fit_tol = _fit_tolerance(spec.tolerance)
-    breaks = np.array([0.0, TWO_PI])  # the edge's ends; a corner (a velocity jump) is refused earlier
+    breaks, straight = _breaks(cam)
     lead = r + spec.tool_diameter  # the tool enters and leaves this far beyond the bar's ends [mm]
     reverse = spec.direction is not Direction.CLIMB  # climb runs towards +x, with increasing φ
-    finish = fit_open_path(cam, r, breaks, spec.tolerance, fit_tol, reverse=reverse, arcs=arcs)
+    finish = fit_open_path(
+        cam, r, breaks, spec.tolerance, fit_tol, reverse=reverse, arcs=arcs, straight=straight
+    )
     if stock <= 0.0:
         rough = finish
     elif (
         arcs
     ):  # the finishing arc spline offset by the stock (arcs stay arcs), measured; refitted if it misses
-        rough = offset_open_path(cam, finish, r + stock, breaks, spec.tolerance, fit_tol)
+        rough = offset_open_path(cam, finish, r + stock, breaks, spec.tolerance, fit_tol, straight=straight)
     else:  # chords offset apart at their corners: fit them afresh
         rough = fit_open_path(cam, r + stock, breaks, spec.tolerance, fit_tol, reverse=reverse, arcs=False)
 
@@ -139,3 +148,25 @@ def plan_bar(
             *([_NO_REFIT] if spec.fewest_arcs and arcs else []),
         ),
     )
+
+
+def _breaks(cam: Cam) -> tuple[FloatArray, tuple[bool, ...]]:
+    """The edge's break nodes φ [rad] and, per interval between them, whether the edge is straight there.
+
+    The nodes are the edge's ends (a corner, a velocity jump, is refused
+    earlier) and the ends of its straight stretches (the motion's dwells,
+    :attr:`~camcad.geometry.cam.Cam.straight_spans`), each of which is cut
+    as one line (G1) between the arcs.
+    """
+    nodes = [0.0, TWO_PI]
+    spans = []
+    for a, b in cam.straight_spans:
+        lo, hi = max(a, 0.0), min(b, TWO_PI)
+        # a span's end within 1e-9 rad of a node is that node (2π summed from the segments' spans)
+        lo, hi = (next((n for n in nodes if abs(n - v) <= _SAME_NODE), v) for v in (lo, hi))
+        if hi - lo > _SAME_NODE:
+            spans.append((lo, hi))
+            nodes += [lo, hi]
+    edges = np.array(sorted(set(nodes)))
+    straight = tuple(any(lo <= a and b <= hi for lo, hi in spans) for a, b in itertools.pairwise(edges))
+    return edges, straight

@@ -21,7 +21,7 @@ import numpy as np
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import ArcSearchStallError
-from camcad.toolpath.arcs.biarc import CurveFn, Pieces, concat_pieces
+from camcad.toolpath.arcs.biarc import CurveFn, Pieces, chord_pieces, concat_pieces, measure_deviation
 from camcad.toolpath.arcs.march import march_arcs
 from camcad.toolpath.arcs.refine import thin_loop
 from camcad.toolpath.arcs.search import search_arcs
@@ -37,6 +37,7 @@ def fit_arc_spline(
     arcs: bool = True,
     closed: bool = False,
     fewest_arcs: bool = False,
+    straight: Sequence[bool] = (),
 ) -> tuple[Pieces, FloatArray]:
     """Fit a tangent-continuous arc spline (or chords) to C(φ) between sorted φ-breaks within a tolerance.
 
@@ -62,6 +63,13 @@ def fit_arc_spline(
         With ``closed``: refit the loop with fewer arcs where the measured
         deviation allows (:func:`~camcad.toolpath.arcs.refine.thin_loop`);
         the loop then starts abeam C(a).
+    straight
+        Per break interval, True where C is exactly a straight line there (a
+        linear cam's dwell, :attr:`camcad.geometry.cam.Cam.straight_spans`);
+        empty: none is. Such an interval is the one line from C(a) to C(b),
+        measured like every piece; the arcs beside it end and start on its
+        ends with the curve's tangent, the line's own, so the spline stays
+        tangent continuous.
 
     Returns
     -------
@@ -73,7 +81,9 @@ def fit_arc_spline(
     ------
     ValueError
         When an interval shorter than 1e-9 rad still misses the tolerance
-        (a corner or cusp of the curve).
+        (a corner or cusp of the curve), when ``straight`` does not have one
+        flag per interval, or when an interval said to be straight is not
+        (its line misses the tolerance).
 
     Notes
     -----
@@ -103,7 +113,15 @@ def fit_arc_spline(
     parts: list[Pieces] = []
     devs: list[FloatArray] = []
     loop = closed and edges.size == 2
-    for a, b in itertools.pairwise(edges):
+    flags = tuple(straight) or (False,) * (edges.size - 1)
+    if len(flags) != edges.size - 1:
+        raise ValueError(f"{len(flags)} straight flags for {edges.size - 1} break intervals")
+    for (a, b), line in zip(itertools.pairwise(edges), flags, strict=True):
+        if line:
+            piece, piece_dev = _line(curve, float(a), float(b), tolerance)
+            parts.append(piece)
+            devs.append(piece_dev)
+            continue
         try:
             done, dev = search_arcs(curve, float(a), float(b), tolerance, closed=loop)
         except ArcSearchStallError:
@@ -117,3 +135,17 @@ def fit_arc_spline(
         out, dev_all = fewer
     readonly(dev_all)
     return out, dev_all
+
+
+def _line(curve: CurveFn, a: float, b: float, tolerance: float) -> tuple[Pieces, FloatArray]:
+    """The line from C(a) to C(b) [mm] of a straight interval, and its measured deviation (1,) [mm]."""
+    ends = np.array([a, b])
+    pts, d1, _ = curve(ends)
+    tan = d1 / np.linalg.norm(d1, axis=1)[:, None]
+    piece = chord_pieces(ends[:1], ends[1:], pts[:1], tan[:1], pts[1:], tan[1:])
+    dev = measure_deviation(curve, piece)
+    if not float(dev[0]) <= tolerance:
+        raise ValueError(
+            f"the interval {a:.6f}..{b:.6f} rad is not straight: its line is {dev[0]:.3g} mm off"
+        )
+    return piece, dev
