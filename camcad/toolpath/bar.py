@@ -20,9 +20,11 @@ written 4 decimals with each arc's I/J from its rounded start, and measured
 two-way against the exact curve after rounding; the roughing path is the
 finishing arc spline offset by the stock, measured the same way. Each
 dwell of the motion is a straight stretch of the edge and of its offsets
-(:attr:`~camcad.geometry.cam.Cam.straight_spans`): it is a break node at
-both ends and cut as one line (G1, a LINE in ``profile_arcs.dxf``) between
-them, the arcs beside it ending and starting there on its tangent.
+(:attr:`~camcad.geometry.cam.Cam.straight_spans`): its ends are break
+nodes and it is cut as one line (G1) on the exact line to its end, from
+its start or from before it where one arc lands on the line touching it;
+the arcs beside it are tangent to it (``profile_arcs.dxf`` draws it as one
+LINE from its start to its end).
 """
 
 from __future__ import annotations

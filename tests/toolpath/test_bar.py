@@ -11,8 +11,9 @@
   ``max_deviation`` bounds; climb runs with the part on the tool's right
   (towards +x); G1 chords at the same tolerance need several times the blocks.
 - Straight stretches (a linear cam's dwells): over open curves with an
-  exactly straight stretch (hypothesis), the stretch is one line from its
-  exact start to its exact end, G1 with the arcs beside it; on the bar,
+  exactly straight stretch (hypothesis), the stretch is one line on it to
+  its exact end, from its start or from where the arc before lands on it,
+  G1 with the arcs beside it; on the bar,
   each dwell is one G1 move on the line the sample's numbers give
   (y = base radius + the dwell's lift + tool radius, x = Lφ/2π), between
   arcs tangent to it.
@@ -128,21 +129,38 @@ def test_an_open_curve_s_straight_stretch_is_one_line_on_it_between_tangent_arcs
     straight = tuple(bool(a == p and b == q) for a, b in itertools.pairwise(breaks))
     pieces, dev = fit_arc_spline(curve, breaks, tol, closed=False, straight=straight)
     assert dev.max() <= tol
-    # the stretch: exactly one line, from the stretch's start to its end, both on the exact line y = slope·x
+    # the stretch: exactly one line over all of it, on the exact line y = slope·x, ending at the stretch's
+    # end; it starts at the stretch's start, or before it where the arc before lands on the line
     c = length / (2.0 * math.pi)
-    flat = np.flatnonzero((pieces.lo >= p) & (pieces.hi <= q))
+    flat = np.flatnonzero((pieces.hi > p) & (pieces.lo < q))
     assert flat.size == 1
     (i,) = flat
     assert pieces.line[i, 0] and np.array_equal(pieces.start[i, 1], pieces.end[i, 1])  # one line, no second
-    for end, at in ((pieces.start[i, 0], p), (pieces.end[i, 0], q)):
-        assert_allclose(end, (c * at, slope * c * at), atol=1e-9)
-    # G1 through the line's ends and everywhere else, and two-way within tol by brute force
+    assert pieces.lo[i] <= p and pieces.hi[i] == q
+    start, end = pieces.start[i, 0], pieces.end[i, 0]
+    assert_allclose(end, (c * q, slope * c * q), atol=1e-9)
+    assert start[0] <= c * p + 1e-9
+    assert abs(start[1] - slope * start[0]) <= 1e-9 * max(1.0, abs(start[0]))
+    # G1 through the line's ends (on the line's own direction) and everywhere else, and two-way within
+    # tol by brute force
     starts, stops = pieces.tangents()
+    u = np.array([1.0, slope]) / math.hypot(1.0, slope)
+    if i > 0:
+        assert_allclose(
+            stops[i - 1, 0 if pieces.line[i - 1, 1] and not pieces.length()[i - 1, 1] else 1], u, atol=1e-9
+        )
+    if i + 1 < len(pieces):
+        assert_allclose(starts[i + 1, 0], u, atol=1e-9)
     flat_start, flat_end = pieces.start.reshape(-1, 2), pieces.end.reshape(-1, 2)
     live = np.linalg.norm(flat_end - flat_start, axis=1) > 0.0
     t0, t1 = starts.reshape(-1, 2)[live], stops.reshape(-1, 2)[live]
     assert_allclose(flat_end[live][:-1], flat_start[live][1:], atol=1e-9)
-    assert_allclose(t1[:-1], t0[1:], atol=1e-7)
+    # elsewhere: an arc bulging less than 1e-9 mm is stored as its chord (biarc.arc_from_tangent), whose
+    # direction is off the arc's end tangents by up to 8·sagitta/chord: up to 3e-4 rad on a chord of a
+    # few µm, which hypothesis finds now and then with or without straight stretches
+    short_line = pieces.line.reshape(-1)[live] & (pieces.length().reshape(-1)[live] < 0.1)
+    smooth = ~(short_line[:-1] | short_line[1:])
+    assert_allclose(t1[:-1][smooth], t0[1:][smooth], atol=1e-7)
     assert_two_way_within(curve, pieces, tol)
 
 
@@ -218,7 +236,9 @@ def test_each_dwell_of_the_bar_is_one_g1_on_its_exact_line_between_tangent_arcs(
         assert len(on) == 1  # the whole dwell is one move
         m = cut[on[0]]
         assert not m.kind.is_arc
-        assert sorted((m.start[0], m.end[0])) == pytest.approx([xa, xb], abs=1e-9)
+        lo, hi = sorted((m.start[0], m.end[0]))
+        # it ends where the dwell ends and starts there or before, where the arc before landed on the line
+        assert hi == pytest.approx(xb, abs=1e-9) and lo <= xa + 1e-9
         assert m.start[1] == m.end[1] == pytest.approx(y, abs=1e-9)
         # its neighbours are arcs tangent to it: their centres straight above or below its ends
         for k, joint in ((on[0] - 1, m.start), (on[0] + 1, m.end)):

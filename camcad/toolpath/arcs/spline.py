@@ -66,10 +66,13 @@ def fit_arc_spline(
     straight
         Per break interval, True where C is exactly a straight line there (a
         linear cam's dwell, :attr:`camcad.geometry.cam.Cam.straight_spans`);
-        empty: none is. Such an interval is the one line from C(a) to C(b),
-        measured like every piece; the arcs beside it end and start on its
-        ends with the curve's tangent, the line's own, so the spline stays
-        tangent continuous.
+        empty: none is. Such an interval is one line to C(b), measured like
+        every piece: the search before it ends with one arc that lands on
+        the line, touching it at or before C(a), where it can
+        (:func:`~camcad.toolpath.arcs.search.search_arcs` with ``onto_line``),
+        else with a biarc onto C(a) on the line's direction, and the line
+        runs on from there; the search after it starts on C(b) with the
+        line's direction. The spline stays tangent continuous.
 
     Returns
     -------
@@ -116,14 +119,17 @@ def fit_arc_spline(
     flags = tuple(straight) or (False,) * (edges.size - 1)
     if len(flags) != edges.size - 1:
         raise ValueError(f"{len(flags)} straight flags for {edges.size - 1} break intervals")
-    for (a, b), line in zip(itertools.pairwise(edges), flags, strict=True):
+    for k, ((a, b), line) in enumerate(zip(itertools.pairwise(edges), flags, strict=True)):
         if line:
-            piece, piece_dev = _line(curve, float(a), float(b), tolerance)
+            # the line runs on from where the arcs before it landed on it (at or before C(a))
+            landed = parts[-1] if parts else None
+            piece, piece_dev = _line(curve, float(a), float(b), tolerance, landed)
             parts.append(piece)
             devs.append(piece_dev)
             continue
+        onto = k + 1 < len(flags) and flags[k + 1]
         try:
-            done, dev = search_arcs(curve, float(a), float(b), tolerance, closed=loop)
+            done, dev = search_arcs(curve, float(a), float(b), tolerance, closed=loop, onto_line=onto)
         except ArcSearchStallError:
             fallback, fdev = march_arcs(curve, np.array([a, b]), tolerance, arcs=True)
             done, dev = [fallback], [fdev]
@@ -137,11 +143,22 @@ def fit_arc_spline(
     return out, dev_all
 
 
-def _line(curve: CurveFn, a: float, b: float, tolerance: float) -> tuple[Pieces, FloatArray]:
-    """The line from C(a) to C(b) [mm] of a straight interval, and its measured deviation (1,) [mm]."""
+def _line(
+    curve: CurveFn, a: float, b: float, tolerance: float, before: Pieces | None
+) -> tuple[Pieces, FloatArray]:
+    """The line of a straight interval to C(b) [mm], and its measured deviation (1,) [mm].
+
+    It starts at C(a), or where the pieces ``before`` it end when their last
+    arc landed on the line ahead of C(a) (its φ-interval then starts abeam
+    that point).
+    """
     ends = np.array([a, b])
     pts, d1, _ = curve(ends)
     tan = d1 / np.linalg.norm(d1, axis=1)[:, None]
+    if before is not None and float(before.hi[-1]) < a:
+        pts = pts.copy()
+        ends[0] = before.hi[-1]
+        pts[0] = before.end[-1, 1]  # the landing arc's end (its second piece is empty)
     piece = chord_pieces(ends[:1], ends[1:], pts[:1], tan[:1], pts[1:], tan[1:])
     dev = measure_deviation(curve, piece)
     if not float(dev[0]) <= tolerance:
