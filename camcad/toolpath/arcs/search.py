@@ -604,8 +604,8 @@ def search_arcs(
         shrunk to 0.2 tol.
     """
     # when an arc kept unmeasured fails on the path, search again measuring every arc
-    found = _search(curve, a, b, tolerance, closed, _SURE, onto_line)
-    found = found or _search(curve, a, b, tolerance, closed, -math.inf, onto_line)
+    found = _search(curve, a, b, tolerance, closed, _SURE, onto_line=onto_line)
+    found = found or _search(curve, a, b, tolerance, closed, -math.inf, onto_line=onto_line)
     assert found is not None  # every arc measured: none can fail on the path
     return found
 
