@@ -1,7 +1,12 @@
 """Benchmark of the G-code toolpath: biarc blocks against G1-only paths at the same tolerance.
 
-Run ``python benchmarks/gcode.py [tolerance_mm]`` (default 0.005); prints a
-Markdown table per shipped sample (``samples/*.toml``):
+Run ``python benchmarks/gcode.py [tolerance_mm] [sample ...]`` (default
+0.005, every sample); prints a Markdown table per shipped sample
+(``samples/*.toml``; named samples, e.g. ``linear_cam``, print their rows
+only and leave ``benchmarks/README.md`` as it was). A linear cam is planned
+as its bar (:func:`camcad.toolpath.bar.plan_bar`: the open edge, its dwells
+cut as lines); barrel cams have their own benchmark (``barrel.py``) and are
+left out; every other sample as a plate's outline:
 
 - contour blocks: one finishing contour (leads excluded) written with biarcs,
   with greedy maximal G1 chords (the fewest an interpolating G1 path can
@@ -32,19 +37,21 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from camcad.design import load_design
+from camcad.design import Design, load_design
 from camcad.export.gcode import count_blocks, render_gcode
 from camcad.geometry.cam import Cam
+from camcad.geometry.families import family_of
 from camcad.toolpath import Toolpath, plan_toolpath
 from camcad.toolpath.arcs.biarc import chord_pieces, measure_deviation
+from camcad.toolpath.bar import plan_bar
 from camcad.toolpath.contour import offset_curve
 from camcad.toolpath.plan import _fit_tolerance
 from camcad.toolpath.spec import GcodeSpec
@@ -91,29 +98,62 @@ def fewest_arcs(cam: Cam, radius: float, band: float, n: int = 200_000) -> float
     return float(np.sum((rate / (72.0 * math.sqrt(3.0) * band)) ** (1.0 / 3.0) * ds))
 
 
-def least_of_3(cam: Cam, spec: GcodeSpec, **kw: Any) -> tuple[Toolpath, float]:
+Planner = Callable[..., Toolpath]
+
+
+def least_of_3(plan: Planner, spec: GcodeSpec) -> tuple[Toolpath, float]:
     """The plan and its least wall time [s] of three runs (the machine's other load moves single runs)."""
     times = []
     for _ in range(3):
         start = time.perf_counter()
-        out = plan_toolpath(cam, spec, **kw)
+        out = plan(spec)
         times.append(time.perf_counter() - start)
     return out, min(times)
 
 
-def main(tolerance: float = 0.005) -> None:
-    """Print the benchmark table for every shipped sample."""
+def planner(design: Design) -> tuple[Cam, Planner] | None:
+    """The cam whose finishing path is measured and its planner ``plan(spec, arcs=True)``; None: a barrel.
+
+    A linear cam's part is its bar (the cam with its stroke length, an open
+    edge): it is planned as the bar; every other design as the plate of
+    ``Cam.from_design`` cut along its outline.
+    """
+    cam = Cam.from_design(design)
+    (part, *_) = family_of(design.cam.style).parts(cam, design.family_options())
+    if part.barrel is not None:
+        return None
+    name, thickness = design.cam.name, design.cam.thickness
+    if part.bar is not None:
+        bar_cam, bar = part.cam, part.bar
+
+        def plan_edge(spec: GcodeSpec, arcs: bool = True) -> Toolpath:
+            return plan_bar(bar_cam, bar, spec, name=name, thickness=thickness, arcs=arcs)
+
+        return bar_cam, plan_edge
+
+    def plan_plate(spec: GcodeSpec, arcs: bool = True) -> Toolpath:
+        return plan_toolpath(cam, spec, name=name, thickness=thickness, bore=design.cam.bore, arcs=arcs)
+
+    return cam, plan_plate
+
+
+def main(tolerance: float = 0.005, samples: Sequence[str] = ()) -> None:
+    """Print the benchmark table for every shipped sample, or for the named ones."""
     rows = []
     for path in sorted((ROOT / "samples").glob("*.toml")):
+        if samples and path.stem not in samples:
+            continue
         design = load_design(path)
         spec = replace(design.gcode, tolerance=tolerance)
-        cam = Cam.from_design(design)
-        kw = {"name": design.cam.name, "thickness": design.cam.thickness, "bore": design.cam.bore}
-        arcs, elapsed = least_of_3(cam, spec, **kw)
-        lines = plan_toolpath(cam, spec, arcs=False, **kw)
+        found = planner(design)
+        if found is None:
+            continue
+        cam, plan = found
+        arcs, elapsed = least_of_3(plan, spec)
+        lines = plan(spec, arcs=False)
         uniform = uniform_chords(cam, spec.tool_radius, 0.8 * tolerance)
         least = fewest_arcs(cam, spec.tool_radius, _fit_tolerance(tolerance))
-        thin, thin_time = least_of_3(cam, replace(spec, fewest_arcs=True), **kw)
+        thin, thin_time = least_of_3(plan, replace(spec, fewest_arcs=True))
         prog_arcs = count_blocks(render_gcode(arcs))
         prog_lines = count_blocks(render_gcode(lines))
         rows.append(
@@ -157,5 +197,9 @@ def main(tolerance: float = 0.005) -> None:
 if __name__ == "__main__":
     from _readme import captured  # this folder is on sys.path when the script runs
 
-    with captured("gcode"):  # the printed tables become its section of benchmarks/README.md
-        main(float(sys.argv[1]) if len(sys.argv) > 1 else 0.005)
+    tol = float(sys.argv[1]) if len(sys.argv) > 1 else 0.005
+    if len(sys.argv) > 2:  # named samples: their rows only, not a section of the README
+        main(tol, sys.argv[2:])
+    else:
+        with captured("gcode"):  # the printed tables become its section of benchmarks/README.md
+            main(tol)

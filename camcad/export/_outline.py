@@ -23,6 +23,7 @@ from camcad.toolpath.arcs.biarc import (
     CurveFn,
     Pieces,
     biarc_pieces,
+    chord_pieces,
     concat_pieces,
     measure_deviation,
     take_pieces,
@@ -312,7 +313,13 @@ ARC_SPLIT_SAFETY = 1.15  # a few more parts than the h³ law asks for, so one sp
 ARC_MAX_ROUNDS = 40  # halvings of an interval: 2π/2^40 rad is far below any real tolerance
 
 
-def arc_outline(curve: CurveFn, breakpoints: Sequence[float], tolerance: float) -> tuple[Pieces, FloatArray]:
+def arc_outline(
+    curve: CurveFn,
+    breakpoints: Sequence[float],
+    tolerance: float,
+    *,
+    straight: Sequence[tuple[float, float]] = (),
+) -> tuple[Pieces, FloatArray]:
     """Tangent-continuous arcs through a curve C(φ), φ ∈ [0, 2π], within ``tolerance`` [mm].
 
     A closed curve (a plate's profile) closes where C(2π) = C(0); an open one
@@ -328,6 +335,11 @@ def arc_outline(curve: CurveFn, breakpoints: Sequence[float], tolerance: float) 
         (motion segment joins: the curvature may jump there).
     tolerance
         Largest two-way deviation [mm].
+    straight
+        φ-spans [rad] over which C is exactly a straight line (a linear
+        cam's dwells, :attr:`camcad.geometry.cam.Cam.straight_spans`): each
+        interval between breakpoints inside one is a single line from its
+        exact start to its exact end (measured like the biarcs), not split.
 
     Returns
     -------
@@ -353,11 +365,27 @@ def arc_outline(curve: CurveFn, breakpoints: Sequence[float], tolerance: float) 
     two_pi = 2.0 * math.pi
     cuts = np.unique(np.concatenate(([0.0, two_pi], np.mod(np.asarray(breakpoints, dtype=float), two_pi))))
     cuts = cuts[np.concatenate(([True], np.diff(cuts) > 1e-9))]
-    lo = np.concatenate([np.linspace(a, b, ARC_START_PIECES + 1)[:-1] for a, b in itertools.pairwise(cuts)])
-    hi = np.append(lo[1:], two_pi)
     done: list[Pieces] = []
     devs: list[FloatArray] = []
+    spans = [(a, b) for a, b in itertools.pairwise(cuts) if not _straight(a, b, straight)]
+    lines = [(a, b) for a, b in itertools.pairwise(cuts) if _straight(a, b, straight)]
+    if lines:  # one line per straight interval, on the curve's exact ends
+        ends = np.array(lines)
+        pt, d1, _d2 = curve(ends.ravel())
+        tangent = d1 / np.linalg.norm(d1, axis=1)[:, None]
+        chords = chord_pieces(ends[:, 0], ends[:, 1], pt[0::2], tangent[0::2], pt[1::2], tangent[1::2])
+        dev = measure_deviation(curve, chords)
+        if not np.all(dev <= tolerance):
+            raise ValueError(f"a straight span is {float(dev.max()):.3g} mm off its line")
+        done.append(chords)
+        devs.append(dev)
+    lo = np.concatenate([np.linspace(a, b, ARC_START_PIECES + 1)[:-1] for a, b in spans] or [np.zeros(0)])
+    hi = np.concatenate(
+        [np.append(np.linspace(a, b, ARC_START_PIECES + 1)[1:-1], b) for a, b in spans] or [lo]
+    )
     for _ in range(ARC_MAX_ROUNDS):
+        if lo.size == 0:  # every interval is straight
+            break
         pt, d1, _d2 = curve(np.concatenate((lo, hi)))
         tangent = d1 / np.linalg.norm(d1, axis=1)[:, None]
         n = lo.size
@@ -380,6 +408,11 @@ def arc_outline(curve: CurveFn, breakpoints: Sequence[float], tolerance: float) 
     dev_all = np.concatenate(devs)[order]
     readonly(dev_all)
     return out, dev_all
+
+
+def _straight(a: float, b: float, spans: Sequence[tuple[float, float]]) -> bool:
+    """Whether [a, b] lies inside one of the straight φ-spans (1e-9 rad slack at the ends)."""
+    return any(lo - 1e-9 <= a and b <= hi + 1e-9 for lo, hi in spans)
 
 
 def _split(lo: FloatArray, hi: FloatArray, parts: np.ndarray) -> tuple[FloatArray, FloatArray]:

@@ -597,7 +597,7 @@ def profile_arcs_document(
 
         tol = curve.fit.tolerance
         try:
-            pieces, _ = arc_outline(exact, list(cam.program.pieces), tol)
+            pieces, _ = arc_outline(exact, list(cam.program.pieces), tol, straight=cam.straight_spans)
         except ValueError as err:  # a corner in the profile: a velocity jump, refused earlier as a hard limit
             raise ExportError(f"profile_arcs.dxf: {err}") from err
         _add_arcs(msp, pieces, curve.layer)
@@ -802,7 +802,7 @@ def _bar_edge_arcs(cam: Cam, tolerance: float) -> Pieces:
         return o.point, o.d1, o.d2
 
     try:
-        pieces, _ = arc_outline(exact, list(cam.program.pieces), tolerance)
+        pieces, _ = arc_outline(exact, list(cam.program.pieces), tolerance, straight=cam.straight_spans)
     except ValueError as err:
         raise ExportError(f"profile_arcs.dxf: {err}") from err
     return pieces

@@ -226,6 +226,25 @@ class Cam:
         """A linear cam's plate travel per radian of the motion, c = L/2π [mm/rad]; None for a disc cam."""
         return None if self.stroke_length is None else self.stroke_length / TWO_PI
 
+    @property
+    def straight_spans(self) -> tuple[tuple[float, float], ...]:
+        """φ-intervals [rad] over which the profile and its offsets are straight lines; () on a disc cam.
+
+        On a linear cam the follower stands still through each dwell of the
+        motion while the bar slides under it, so the contact element's path
+        relative to the bar, and with it the profile and every offset of it,
+        is a line parallel to the travel over the dwell's span. Taken from the
+        motion's dwell segments, not from samples. (A disc cam's dwell is a
+        circle about the cam's axis.)
+        """
+        if self.stroke_length is None:
+            return ()
+        return tuple(
+            (start, start + seg.span)
+            for start, seg in zip(self.program.starts, self.program.segments, strict=True)
+            if seg.kind is SegmentKind.DWELL and seg.span > 0.0
+        )
+
     def frame_angle(self, phi: ArrayLike) -> FloatArray:
         """The angle [rad] the cam frame is turned by at motion angles φ: φ on a disc, 0 on a linear cam.
 

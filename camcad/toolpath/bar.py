@@ -18,15 +18,23 @@ from the curve's start on its tangent to its end), fitted within the
 plate's band (``_fit_tolerance`` of :mod:`camcad.toolpath.plan`), rounded to the
 written 4 decimals with each arc's I/J from its rounded start, and measured
 two-way against the exact curve after rounding; the roughing path is the
-finishing arc spline offset by the stock, measured the same way.
+finishing arc spline offset by the stock, measured the same way. Each
+dwell of the motion is a straight stretch of the edge and of its offsets
+(:attr:`~camcad.geometry.cam.Cam.straight_spans`): its ends are break
+nodes and it is cut as one line (G1) on the exact line to its end, from
+its start or from before it where one arc lands on the line touching it;
+the arcs beside it are tangent to it (``profile_arcs.dxf`` draws it as one
+LINE from its start to its end).
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 
+from camcad._typing import FloatArray
 from camcad.angles import TWO_PI
 from camcad.geometry.cam import Cam
 from camcad.geometry.families import Bar
@@ -39,6 +47,7 @@ from camcad.toolpath.spec import Direction, GcodeSpec
 
 __all__ = ["plan_bar"]
 
+_SAME_NODE = 1e-9  # rad: break nodes this close are one
 _NO_REFIT = "the fewest-arcs refit thins closed contours only: the edge keeps the search's arcs"
 
 
@@ -79,16 +88,18 @@ def plan_bar(
         else spec.stock_to_leave
     )
     fit_tol = _fit_tolerance(spec.tolerance)
-    breaks = np.array([0.0, TWO_PI])  # the edge's ends; a corner (a velocity jump) is refused earlier
+    breaks, straight = _breaks(cam)
     lead = r + spec.tool_diameter  # the tool enters and leaves this far beyond the bar's ends [mm]
     reverse = spec.direction is not Direction.CLIMB  # climb runs towards +x, with increasing φ
-    finish = fit_open_path(cam, r, breaks, spec.tolerance, fit_tol, reverse=reverse, arcs=arcs)
+    finish = fit_open_path(
+        cam, r, breaks, spec.tolerance, fit_tol, reverse=reverse, arcs=arcs, straight=straight
+    )
     if stock <= 0.0:
         rough = finish
     elif (
         arcs
     ):  # the finishing arc spline offset by the stock (arcs stay arcs), measured; refitted if it misses
-        rough = offset_open_path(cam, finish, r + stock, breaks, spec.tolerance, fit_tol)
+        rough = offset_open_path(cam, finish, r + stock, breaks, spec.tolerance, fit_tol, straight=straight)
     else:  # chords offset apart at their corners: fit them afresh
         rough = fit_open_path(cam, r + stock, breaks, spec.tolerance, fit_tol, reverse=reverse, arcs=False)
 
@@ -139,3 +150,25 @@ def plan_bar(
             *([_NO_REFIT] if spec.fewest_arcs and arcs else []),
         ),
     )
+
+
+def _breaks(cam: Cam) -> tuple[FloatArray, tuple[bool, ...]]:
+    """The edge's break nodes φ [rad] and, per interval between them, whether the edge is straight there.
+
+    The nodes are the edge's ends (a corner, a velocity jump, is refused
+    earlier) and the ends of its straight stretches (the motion's dwells,
+    :attr:`~camcad.geometry.cam.Cam.straight_spans`), each of which is cut
+    as one line (G1) between the arcs.
+    """
+    nodes = [0.0, TWO_PI]
+    spans = []
+    for a, b in cam.straight_spans:
+        lo, hi = max(a, 0.0), min(b, TWO_PI)
+        # a span's end within 1e-9 rad of a node is that node (2π summed from the segments' spans)
+        lo, hi = (next((n for n in nodes if abs(n - v) <= _SAME_NODE), v) for v in (lo, hi))
+        if hi - lo > _SAME_NODE:
+            spans.append((lo, hi))
+            nodes += [lo, hi]
+    edges = np.array(sorted(set(nodes)))
+    straight = tuple(any(lo <= a and b <= hi for lo, hi in spans) for a, b in itertools.pairwise(edges))
+    return edges, straight

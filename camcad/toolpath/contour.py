@@ -406,6 +406,7 @@ def fit_open_path(
     *,
     reverse: bool,
     arcs: bool = True,
+    straight: Sequence[bool] = (),
 ) -> OpenPath:
     """Fit, orient, round and measure the open path ``cam.offset_curve(phi, distance)`` over ``breaks``.
 
@@ -417,26 +418,37 @@ def fit_open_path(
     travels from the last break to the first. ``tol`` and ``fit_tol`` [mm]
     as for :func:`fit_contour`: the deviation is measured after rounding,
     two-way, and must be within ``tol``. ``arcs`` False writes G1 chords
-    only (for comparison).
+    only (for comparison). ``straight`` flags the break intervals over which
+    the curve is a straight line (a linear cam's dwells): each is written as
+    one line on the exact curve's ends (with arcs; chords are lines anyway).
     """
     curve = offset_curve(cam, distance)
     try:
-        pieces, _ = fit_arc_spline(curve, breaks, fit_tol, arcs=arcs, closed=False)
+        pieces, _ = fit_arc_spline(
+            curve, breaks, fit_tol, arcs=arcs, closed=False, straight=straight if arcs else ()
+        )
     except ValueError as err:  # pragma: no cover - only for a cusp the gouge check missed
         raise DesignLimitError(f"cannot fit the toolpath: {err}") from err
     return _realise_open(curve, distance, pieces, tol, reverse=reverse)
 
 
 def offset_open_path(
-    cam: Cam, base: OpenPath, distance: float, breaks: FloatArray, tol: float, fit_tol: float
+    cam: Cam,
+    base: OpenPath,
+    distance: float,
+    breaks: FloatArray,
+    tol: float,
+    fit_tol: float,
+    *,
+    straight: Sequence[bool] = (),
 ) -> OpenPath:
     """The open path ``cam.offset_curve(phi, distance)`` as the offset of another path's arc spline.
 
     As :func:`offset_contour` for a closed contour: ``base``'s pieces offset
     by ``distance − base.distance`` (arcs stay arcs), measured two-way
     against the exact curve and used where within ``fit_tol``; otherwise
-    the curve is fitted afresh (:func:`fit_open_path`). The travel direction
-    is ``base``'s.
+    the curve is fitted afresh (:func:`fit_open_path`, with ``straight``). The
+    travel direction is ``base``'s; a line of ``base`` stays a line.
     """
     curve = offset_curve(cam, distance)
     at = cam.offset_curve(np.array([breaks[0]]), base.distance)
@@ -444,7 +456,7 @@ def offset_open_path(
     moved = offset_pieces(base.pieces, left * (distance - base.distance))
     if moved is not None and float(measure_deviation(curve, moved).max()) <= fit_tol:
         return _realise_open(curve, distance, moved, tol, reverse=base.reverse)
-    return fit_open_path(cam, distance, breaks, tol, fit_tol, reverse=base.reverse)
+    return fit_open_path(cam, distance, breaks, tol, fit_tol, reverse=base.reverse, straight=straight)
 
 
 def _realise_open(curve: CurveFn, distance: float, pieces: Pieces, tol: float, *, reverse: bool) -> OpenPath:

@@ -171,6 +171,36 @@ def test_profile_arcs_dxf_is_the_edge_in_tangent_arcs_closed_by_three_lines(buil
     assert b2[0] - a2[0] == pytest.approx(-design.linear.stroke_length)
 
 
+def test_profile_arcs_dxf_draws_each_dwell_as_one_line_on_the_exact_edge(built):
+    """ezdxf reads each dwell back as one LINE from the dwell's start to its end, ARCs tangent to it."""
+    out, cam = built
+    design = load_design(SAMPLE)
+    doc = ezdxf.readfile(out / "profile_arcs.dxf")
+    entities = list(doc.modelspace().query('*[layer=="CAM_PROFILE"]'))
+    edge = np.asarray(cam.profile(np.array([0.0, 2 * np.pi])).point)
+    loop = chain(entities, edge[0])
+    kinds = [e.dxftype() for e in entities]
+    # the sample: a dwell at lift 20 mm over 120°..180° and one at 0 over 300°..360°; 360° = 240 mm
+    length, base = design.linear.stroke_length, design.cam.base_radius
+    for a, b, y in ((120.0, 180.0, base + 20.0), (300.0, 360.0, base)):
+        xa, xb = edge[0][0] + length * a / 360.0, edge[0][0] + length * b / 360.0
+        over = [
+            k
+            for k, (p, q, _, _) in enumerate(loop)
+            if min(p[0], q[0]) < xb - 1e-3 and max(p[0], q[0]) > xa + 1e-3 and min(p[1], q[1]) > base - 1.0
+        ]
+        assert len(over) == 1
+        p, q, t_in, t_out = loop[over[0]]
+        assert np.allclose(t_in, t_out) and np.allclose(t_in, (1.0, 0.0))  # a line along +x
+        assert np.allclose([p, q], [(xa, y), (xb, y)], atol=1e-9)
+        # tangent continuous with the pieces before and after it on the edge
+        before = loop[over[0] - 1]
+        assert abs(before[3] @ (0.0, 1.0)) < 1e-9
+        if math.dist(q, edge[-1]) > 1e-6:
+            assert abs(loop[over[0] + 1][2] @ (0.0, 1.0)) < 1e-9
+    assert kinds.count("LINE") == 3 + 2  # the bar's three sides and the two dwells
+
+
 def test_cam_stl_is_closed_with_the_bars_volume(built):
     trimesh = pytest.importorskip("trimesh")
     out, cam = built

@@ -226,3 +226,36 @@ def test_a_pivot_below_the_bars_edge_is_a_hard_finding():
     assert hit.limit == pytest.approx(top, abs=1e-6)
     high = analyse(parse_design(linear_data(follower=ARM)), fit=False, toolpath=False, strict=False)
     assert not [f for f in high.findings if f.kind == "pivot clearance"]
+
+
+@pytest.mark.parametrize(
+    "follower",
+    [
+        {"type": "translating-roller", "roller_radius": RF, "offset": 6.0},
+        {"type": "oscillating-roller", "roller_radius": RF, "pivot_distance": 70.0, "arm_length": 60.0},
+    ],
+)
+def test_straight_spans_are_the_dwells_and_the_edge_is_a_line_there(follower):
+    """The follower stands still in a dwell: every offset of the edge is a line along x over its span."""
+    cam = bar_cam(linear_data(follower=follower))
+    spans = cam.straight_spans
+    want = [(math.radians(120.0), math.radians(180.0)), (math.radians(300.0), 2 * math.pi)]
+    assert_allclose(np.array(spans), np.array(want), atol=1e-12)
+    for a, b in spans:
+        for d in (0.0, 5.0):
+            o = cam.offset_curve(np.linspace(a, b, 101), d)
+            pts = np.asarray(o.point)
+            # a line along x travelled at the bar's rate: y constant, x = x(a) + L(φ − a)/2π
+            assert np.ptp(pts[:, 1]) <= 1e-9
+            assert_allclose(
+                pts[:, 0] - pts[0, 0], L * (np.linspace(a, b, 101) - a) / (2 * math.pi), atol=1e-9
+            )
+        # just outside, it is not (the curve leaves the line: not every stretch is straight)
+        if a > 0.0:
+            near = np.asarray(cam.offset_curve(np.array([a - 0.05, a]), 0.0).point)
+            assert abs(near[0, 1] - near[1, 1]) > 1e-6
+    # a disc cam of the same motion has no straight stretch: its dwells are circles
+    disc_data = linear_data(follower=follower)
+    del disc_data["linear"]
+    disc_data["cam"] = {"name": "disc", "base_radius": RB, "thickness": 10.0}
+    assert Cam.from_design(parse_design(disc_data)).straight_spans == ()

@@ -11,7 +11,10 @@ the plate's band (``gcode.tolerance``) after the program's 4-decimal
 rounding, and the planner's certificate (``Toolpath.max_deviation``) bounds
 what the brute force finds. The direction is the plate's rule (M3, climb
 has the part on the tool's right: the closed loop of the pass and the bar's
-bottom runs clockwise).
+bottom runs clockwise). Each dwell of the motion is a straight stretch of the
+offset: rs274 runs it as one STRAIGHT_FEED on the exact line (the offset at
+the dwell's ends, and the line y = base radius + lift + tool radius from the
+sample's numbers) over the whole dwell, between ARC_FEEDs tangent to it.
 """
 
 from __future__ import annotations
@@ -199,3 +202,40 @@ def test_the_brute_force_sees_arcs_written_as_chords():
     )
     assert float(distance_to_curve(sampled(chords), exact).max()) > tol
     assert float(distance_to_curve(sampled(bulging), exact).max()) <= tol
+
+
+@pytest.mark.parametrize("direction", ["climb", "conventional"])
+def test_rs274_runs_each_dwell_as_one_straight_feed_on_the_exact_line(direction, tmp_path):
+    design, cam, _, tp = planned(direction, 0.005)
+    proc, canon = run_rs274(render_gcode(tp), design.gcode.tool_number, tmp_path)
+    assert proc.returncode == 0, errors(proc)
+    cut = passes(parse_canon(canon))[-1][1:-1]
+    r = design.gcode.tool_radius
+    spans = cam.straight_spans
+    assert len(spans) == 2  # the sample's two dwells
+    for a, b in spans:
+        ends = np.asarray(cam.offset_curve(np.array([a, b]), r).point)
+        # the line from the sample's numbers: at base radius + the dwell's lift + tool radius
+        lift = 20.0 if a < math.pi else 0.0
+        assert ends[:, 1] == pytest.approx(design.cam.base_radius + lift + r, abs=1e-9)
+        xa, xb = sorted(ends[:, 0])
+        over = [
+            k
+            for k, m in enumerate(cut)
+            if min(m.start[0], m.end[0]) < xb - 1e-3 and max(m.start[0], m.end[0]) > xa + 1e-3
+        ]
+        assert len(over) == 1
+        m = cut[over[0]]
+        assert m.kind is MoveKind.LINE
+        got = np.array(sorted([m.start[:2], m.end[:2]]))
+        # on the line (as written: 4 decimals), to the dwell's end, from its start or from where the arc
+        # before it landed on the line
+        assert np.abs(got[:, 1] - ends[0, 1]).max() <= 5e-5
+        assert got[1, 0] == pytest.approx(xb, abs=5e-5) and got[0, 0] <= xa + 5e-5
+        # tangent continuity with the arcs beside it: their radius at the joint is normal to the line
+        for k, joint in ((over[0] - 1, m.start), (over[0] + 1, m.end)):
+            if 0 <= k < len(cut):
+                arc = cut[k]
+                assert arc.kind.is_arc and arc.center is not None
+                radial = np.asarray(arc.center[:2]) - np.asarray(joint[:2])
+                assert abs(radial[0]) / np.linalg.norm(radial) < 1e-6

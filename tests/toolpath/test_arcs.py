@@ -512,9 +512,9 @@ def test_an_unmeasured_arc_that_fails_on_the_path_makes_the_search_measure_every
             return out + 2.0 * tol
         return out
 
-    def counted(*args):
-        runs.append(args[-1])
-        return real_search(*args)
+    def counted(*args, **kw):
+        runs.append(args[-1])  # sure
+        return real_search(*args, **kw)
 
     real_search = search._search
     monkeypatch.setattr(search, "measure_deviation", failing_once)

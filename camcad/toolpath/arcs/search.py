@@ -298,6 +298,67 @@ def _close(
     return int(s[fits[i]]), take_pieces(pc, fits[i : i + 1]), float(dev[i])
 
 
+def _land(
+    curve: CurveFn, layer: _Layer, phi: FloatArray, pts: FloatArray, tan: FloatArray, tol: float
+) -> tuple[int, Pieces, float] | None:
+    """The measured arc from a state of the layer that lands on the line C(b) + λ·t_b at or before C(b).
+
+    The line through the end node q₀ along its unit tangent u (left normal ν)
+    is where the curve runs on straight (a linear cam's dwell). The arc from
+    a state (p, t, left normal n) of curvature κ has its centre at p + n/κ;
+    it touches the line travelling along u where its left normal is ν, at
+    X = p + (n − ν)/κ, which lies on the line when κ = (1 − n·ν)/h with
+    h = (p − q₀)·ν (the limit of :func:`_touching` for a circle of infinite
+    radius). Of the arcs that land at or before q₀ (λ ≤ 0), ahead of their
+    state, turn no more than the curve (:func:`_plain`) and pass the
+    measurement, the one with the least deviation is taken.
+
+    Returns the state, the arc (its φ-interval ending abeam X) and its
+    deviation; None when no arc lands within ``tol``.
+    """
+    n = phi.size - 1
+    q0, u = pts[n], tan[n]
+    nu = left_normal(u[None, :])[0]
+    p, t = layer.p, layer.t
+    nl = left_normal(t)
+    h = (p - q0) @ nu
+    with np.errstate(divide="ignore", invalid="ignore"):
+        kappa = (1.0 - nl @ nu) / h
+        x = p + (nl - nu[None, :]) / kappa[:, None]
+    along = (x - q0) @ u
+    ok = np.isfinite(kappa) & np.all(np.isfinite(x), axis=1) & (np.abs(h) > 0.0) & (along <= 0.0)
+    ok &= np.einsum("si,si->s", x - p, t) > 0.0  # ahead of the state
+    ok &= np.linalg.norm(x - p, axis=1) > tol
+    cand = np.flatnonzero(ok)
+    if cand.size == 0:
+        return None
+    speed = float(np.linalg.norm(curve(phi[n : n + 1])[1][0]))
+    phi_x, foot = abeam(curve, x[cand], phi[n] + along[cand] / speed)
+    ok = (norm2(foot - x[cand]) <= tol) & (phi_x > layer.at[cand]) & (phi_x <= phi[n])
+    cand, phi_x = cand[ok], phi_x[ok]
+    # the arc runs from its state to X, the line on from there: its circle near the samples between
+    land = np.clip(np.searchsorted(phi, phi_x), 0, n)
+    ok = _near_samples(p[cand], t[cand], kappa[cand], pts, layer.j[cand], land, tol)
+    cand, phi_x = cand[ok], phi_x[ok]
+    if cand.size == 0:
+        return None
+    pc = single_arcs(layer.at[cand], phi_x, p[cand], t[cand], x[cand])
+    plain = _plain(curve, pc)
+    if not plain.any():
+        return None
+    cand, pc = cand[plain], take_pieces(pc, plain)
+    # the farthest first: measure a few
+    order = np.argsort(-pc.hi, kind="stable")[:_CIRCLE_STATES]
+    cand, pc = cand[order], take_pieces(pc, order)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dev = measure_deviation(curve, pc)
+    dev = np.where(np.isfinite(dev), dev, np.inf)
+    i = int(dev.argmin())
+    if dev[i] > tol:
+        return None
+    return int(cand[i]), take_pieces(pc, np.array([i])), float(dev[i])
+
+
 def _near_samples(
     p: FloatArray,
     t: FloatArray,
@@ -518,6 +579,7 @@ def search_arcs(
     tolerance: float,
     *,
     closed: bool = False,
+    onto_line: bool = False,
 ) -> tuple[list[Pieces], list[FloatArray]]:
     """Arcs from C(a) to C(b), tangent-continuous, on the curve's own tangents at both ends.
 
@@ -528,6 +590,13 @@ def search_arcs(
     on the first arc's circle, and its φ-intervals run from there to the
     same φ + 2π.
 
+    With ``onto_line`` C runs on from C(b) as a straight line along its
+    tangent there (a linear cam's dwell begins at b): the path may then
+    end with one arc that lands on that line at or before C(b), touching
+    it (:func:`_land`), instead of a biarc onto C(b); its last piece then
+    ends at that point X on the line, φ-interval up to the φ abeam X, and
+    the line continues from X.
+
     Raises
     ------
     ArcSearchStallError
@@ -535,14 +604,14 @@ def search_arcs(
         shrunk to 0.2 tol.
     """
     # when an arc kept unmeasured fails on the path, search again measuring every arc
-    found = _search(curve, a, b, tolerance, closed, _SURE)
-    found = found or _search(curve, a, b, tolerance, closed, -math.inf)
+    found = _search(curve, a, b, tolerance, closed, _SURE, onto_line=onto_line)
+    found = found or _search(curve, a, b, tolerance, closed, -math.inf, onto_line=onto_line)
     assert found is not None  # every arc measured: none can fail on the path
     return found
 
 
 def _search(
-    curve: CurveFn, a: float, b: float, tolerance: float, closed: bool, sure: float
+    curve: CurveFn, a: float, b: float, tolerance: float, closed: bool, sure: float, onto_line: bool = False
 ) -> tuple[list[Pieces], list[FloatArray]] | None:
     """The search of :func:`search_arcs`; None when an arc kept unmeasured fails on the path.
 
@@ -574,6 +643,8 @@ def _search(
                 state, close, close_dev, start, start_dev = loop
                 first = (start, start_dev)
                 return _trace(curve, layers, int(near[state]), close, close_dev, tolerance, first)
+        if onto_line and (landed := _land(curve, layer, phi, pts, tan, tolerance)):
+            return _trace(curve, layers, *landed, tolerance)
         near = near[:24]
         if near.size and (done := _close(curve, _pick(layer, near), phi, pts, tan, tan_ang, tolerance)):
             return _trace(curve, layers, int(near[done[0]]), done[1], done[2], tolerance)

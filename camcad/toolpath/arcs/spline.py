@@ -21,7 +21,7 @@ import numpy as np
 
 from camcad._typing import FloatArray, readonly
 from camcad.errors import ArcSearchStallError
-from camcad.toolpath.arcs.biarc import CurveFn, Pieces, concat_pieces
+from camcad.toolpath.arcs.biarc import CurveFn, Pieces, chord_pieces, concat_pieces, measure_deviation
 from camcad.toolpath.arcs.march import march_arcs
 from camcad.toolpath.arcs.refine import thin_loop
 from camcad.toolpath.arcs.search import search_arcs
@@ -37,6 +37,7 @@ def fit_arc_spline(
     arcs: bool = True,
     closed: bool = False,
     fewest_arcs: bool = False,
+    straight: Sequence[bool] = (),
 ) -> tuple[Pieces, FloatArray]:
     """Fit a tangent-continuous arc spline (or chords) to C(φ) between sorted φ-breaks within a tolerance.
 
@@ -62,6 +63,16 @@ def fit_arc_spline(
         With ``closed``: refit the loop with fewer arcs where the measured
         deviation allows (:func:`~camcad.toolpath.arcs.refine.thin_loop`);
         the loop then starts abeam C(a).
+    straight
+        Per break interval, True where C is exactly a straight line there (a
+        linear cam's dwell, :attr:`camcad.geometry.cam.Cam.straight_spans`);
+        empty: none is. Such an interval is one line to C(b), measured like
+        every piece: the search before it ends with one arc that lands on
+        the line, touching it at or before C(a), where it can
+        (:func:`~camcad.toolpath.arcs.search.search_arcs` with ``onto_line``),
+        else with a biarc onto C(a) on the line's direction, and the line
+        runs on from there; the search after it starts on C(b) with the
+        line's direction. The spline stays tangent continuous.
 
     Returns
     -------
@@ -73,7 +84,9 @@ def fit_arc_spline(
     ------
     ValueError
         When an interval shorter than 1e-9 rad still misses the tolerance
-        (a corner or cusp of the curve).
+        (a corner or cusp of the curve), when ``straight`` does not have one
+        flag per interval, or when an interval said to be straight is not
+        (its line misses the tolerance).
 
     Notes
     -----
@@ -103,9 +116,20 @@ def fit_arc_spline(
     parts: list[Pieces] = []
     devs: list[FloatArray] = []
     loop = closed and edges.size == 2
-    for a, b in itertools.pairwise(edges):
+    flags = tuple(straight) or (False,) * (edges.size - 1)
+    if len(flags) != edges.size - 1:
+        raise ValueError(f"{len(flags)} straight flags for {edges.size - 1} break intervals")
+    for k, ((a, b), line) in enumerate(zip(itertools.pairwise(edges), flags, strict=True)):
+        if line:
+            # the line runs on from where the arcs before it landed on it (at or before C(a))
+            landed = parts[-1] if parts else None
+            piece, piece_dev = _line(curve, float(a), float(b), tolerance, landed)
+            parts.append(piece)
+            devs.append(piece_dev)
+            continue
+        onto = k + 1 < len(flags) and flags[k + 1]
         try:
-            done, dev = search_arcs(curve, float(a), float(b), tolerance, closed=loop)
+            done, dev = search_arcs(curve, float(a), float(b), tolerance, closed=loop, onto_line=onto)
         except ArcSearchStallError:
             fallback, fdev = march_arcs(curve, np.array([a, b]), tolerance, arcs=True)
             done, dev = [fallback], [fdev]
@@ -117,3 +141,28 @@ def fit_arc_spline(
         out, dev_all = fewer
     readonly(dev_all)
     return out, dev_all
+
+
+def _line(
+    curve: CurveFn, a: float, b: float, tolerance: float, before: Pieces | None
+) -> tuple[Pieces, FloatArray]:
+    """The line of a straight interval to C(b) [mm], and its measured deviation (1,) [mm].
+
+    It starts at C(a), or where the pieces ``before`` it end when their last
+    arc landed on the line ahead of C(a) (its φ-interval then starts abeam
+    that point).
+    """
+    ends = np.array([a, b])
+    pts, d1, _ = curve(ends)
+    tan = d1 / np.linalg.norm(d1, axis=1)[:, None]
+    if before is not None and float(before.hi[-1]) < a:
+        pts = pts.copy()
+        ends[0] = before.hi[-1]
+        pts[0] = before.end[-1, 1]  # the landing arc's end (its second piece is empty)
+    piece = chord_pieces(ends[:1], ends[1:], pts[:1], tan[:1], pts[1:], tan[1:])
+    dev = measure_deviation(curve, piece)
+    if not float(dev[0]) <= tolerance:
+        raise ValueError(
+            f"the interval {a:.6f}..{b:.6f} rad is not straight: its line is {dev[0]:.3g} mm off"
+        )
+    return piece, dev
