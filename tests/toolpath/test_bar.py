@@ -86,7 +86,13 @@ def test_an_open_curve_s_arc_spline_runs_end_to_end_g1_within_tolerance(length, 
     live = np.linalg.norm(flat_end - flat_start, axis=1) > 0.0
     t0, t1 = starts.reshape(-1, 2)[live], stops.reshape(-1, 2)[live]
     assert_allclose(flat_end[live][:-1], flat_start[live][1:], atol=1e-9)
-    assert_allclose(t1[:-1], t0[1:], atol=1e-7)
+    # an arc bulging less than 1e-9 mm is kept as its chord (biarc.py); the chord's direction is off the
+    # arc's end tangents by half its turn, κL/2 = 4·sagitta/L, which only a piece far below the G-code's
+    # resolution makes visible: each joint may turn by that much for a line beside it
+    chord = np.linalg.norm(flat_end - flat_start, axis=1)[live]
+    slack = np.where(pieces.line.reshape(-1)[live], 4.0 * 1e-9 / chord, 0.0)
+    turn = np.linalg.norm(t1[:-1] - t0[1:], axis=1)
+    assert np.all(turn <= 1e-7 + slack[:-1] + slack[1:]), (turn.max(), chord[np.argmax(turn)])
     assert_two_way_within(curve, pieces, tol)
 
 
