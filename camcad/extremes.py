@@ -170,9 +170,26 @@ class _Layout:
     extra: FloatArray
 
     def rows(self, lo: int, hi: int) -> _Sequence:
-        """The sequence of rows lo … hi − 1."""
-        value = np.take(np.concatenate((self.right[lo:hi], self.extra[lo:hi]), axis=1), self.order, axis=1)
+        """The sequence of rows lo … hi − 1.
+
+        Its columns are copied run by run (the grid's columns keep their
+        order, the extra ones fall in between): one pass over the values.
+        """
+        n = self.right.shape[1]
+        value = np.empty((hi - lo, self.order.size))
+        for a, b, src in self.runs():
+            if src < n:
+                value[:, a:b] = self.right[lo:hi, src : src + b - a]
+            else:
+                value[:, a:b] = self.extra[lo:hi, src - n : src - n + b - a]
         return _Sequence(phi=self.phi, value=value, piece=self.piece, left=self.left)
+
+    def runs(self) -> list[tuple[int, int, int]]:
+        """(a, b, src): columns a … b − 1 of the sequence are source columns src … of right, then extra."""
+        order, n = self.order, self.right.shape[1]
+        cut = np.flatnonzero((np.diff(order) != 1) | (order[1:] == n)) + 1
+        starts, ends = np.r_[0, cut].tolist(), np.r_[cut, order.size].tolist()
+        return [(a, b, int(order[a])) for a, b in zip(starts, ends, strict=True)]
 
 
 def _layout(
@@ -238,14 +255,17 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
     same_next = np.zeros(m, bool)
     same_next[:-1] = seq.piece[:-1] == seq.piece[1:]
     # a finite sample at least its neighbours in its piece, not flat on both sides: compared on the whole
-    # array (a neighbour outside the piece counts as −inf), the rest only at these few candidates
+    # array (a neighbour outside the piece counts as −inf), the rest only at these few candidates. val
+    # holds no NaN (a NaN sample is −inf), so x ≥ y is not (y > x) and x = y is y = x: two comparisons
+    # of neighbours serve both sides
     with np.errstate(invalid="ignore"):
         ge_prev, eq_prev = np.empty(val.shape, bool), np.empty(val.shape, bool)
         ge_next, eq_next = np.empty(val.shape, bool), np.empty(val.shape, bool)
-        np.greater_equal(val[:, 1:], val[:, :-1], out=ge_prev[:, 1:])
+        np.greater(val[:, 1:], val[:, :-1], out=ge_prev[:, 1:])  # for now: greater than the previous
         np.equal(val[:, 1:], val[:, :-1], out=eq_prev[:, 1:])
-        np.greater_equal(val[:, :-1], val[:, 1:], out=ge_next[:, :-1])
-        np.equal(val[:, :-1], val[:, 1:], out=eq_next[:, :-1])
+        np.logical_not(ge_prev[:, 1:], out=ge_next[:, :-1])  # v[i] ≥ v[i + 1]: v[i + 1] not greater
+        eq_next[:, :-1] = eq_prev[:, 1:]
+        np.logical_or(ge_prev[:, 1:], eq_prev[:, 1:], out=ge_prev[:, 1:])
         outside_prev, outside_next = np.flatnonzero(~same_prev), np.flatnonzero(~same_next)
         ge_prev[:, outside_prev] = eq_prev[:, outside_prev] = True  # no neighbour before a piece's start
         ge_next[:, outside_next] = eq_next[:, outside_next] = True  # nor after its end
@@ -545,7 +565,8 @@ def _extremes(
         hi = min(k, lo + _ROW_BLOCK)
         seq = layout.rows(lo, hi)
         sg = sign[lo:hi]
-        val = sg * np.where(np.isnan(seq.value), -sg * np.inf, seq.value)
+        val = sg * seq.value  # signed (exact: ±1), a NaN sample then −inf
+        np.copyto(val, -np.inf, where=np.isnan(val))
         top = np.argmax(val, axis=1)
         best[lo:hi] = val[np.arange(hi - lo), top]
         found += [

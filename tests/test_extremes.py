@@ -195,3 +195,29 @@ def test_every_rows_sample_side_at_once_is_each_rows_alone(seed, k):
     at_joints = np.flatnonzero(np.isin(np.mod(seq.phi, 2 * math.pi), joints) | (seq.phi == 0.0))
     top = rng.choice(np.concatenate((at_joints, rng.integers(0, seq.phi.size, 4))), k)
     assert ex._sample_sides(seq, top, {}) == [ex._sample_side(seq, r, int(top[r])) for r in range(k)]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(min_value=2, max_value=40),
+    joints=st.lists(st.floats(min_value=0.0, max_value=6.28), max_size=5),
+    k=st.integers(min_value=1, max_value=5),
+    lo_hi=st.tuples(st.integers(0, 4), st.integers(1, 5)),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_layout_rows_is_the_sorted_columns(n, joints, k, lo_hi, seed) -> None:
+    """A search's sequence of rows: the grid's and the extra columns taken in ``order`` (the plain gather)."""
+    from camcad.extremes import _layout
+
+    grid = np.sort(np.random.default_rng(seed).uniform(0.0, 2 * math.pi, n))
+    grid = np.unique(np.concatenate((grid, [0.0])))
+    rng = np.random.default_rng(seed + 1)
+
+    def quantity(p, side):
+        return rng.normal(size=(k, p.size))
+
+    layout = _layout(quantity, grid, np.asarray(joints, dtype=float), None, k)
+    lo = min(lo_hi[0], k - 1)
+    hi = min(max(lo + 1, lo_hi[1]), k)
+    plain = np.take(np.concatenate((layout.right[lo:hi], layout.extra[lo:hi]), axis=1), layout.order, axis=1)
+    assert np.array_equal(layout.rows(lo, hi).value, plain)
