@@ -238,26 +238,13 @@ class _Brackets:
     f3: FloatArray
 
 
-def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
-    """Every sampled local maximum of each row of ``val`` (signed: maxima sought) that could beat ``best``.
+def _peaks(val: FloatArray, same_prev: np.ndarray, same_next: np.ndarray) -> np.ndarray:
+    """(k, m) bool: a finite sample at least its neighbours in its piece, not flat on both sides.
 
-    Interior peaks are bracketed by their two neighbours. A peak at a piece's
-    end (a one-sided limit larger than its neighbour) gets the bracket
-    [neighbour, end] too, since the function may rise above the limit just
-    inside the piece. A peak is kept where its value plus four times its drop
-    to the lower neighbour reaches the best sample: for a smooth peak the gain
-    of the true maximum over the sample is at most a quarter of that drop, so
-    this keeps a 16-fold margin.
+    Compared on the whole array (a neighbour outside the piece counts as
+    −inf). ``val`` holds no NaN (a NaN sample is −inf), so x ≥ y is not
+    (y > x) and x = y is y = x: two comparisons of neighbours serve both sides.
     """
-    m = val.shape[1]
-    same_prev = np.zeros(m, bool)
-    same_prev[1:] = seq.piece[1:] == seq.piece[:-1]
-    same_next = np.zeros(m, bool)
-    same_next[:-1] = seq.piece[:-1] == seq.piece[1:]
-    # a finite sample at least its neighbours in its piece, not flat on both sides: compared on the whole
-    # array (a neighbour outside the piece counts as −inf), the rest only at these few candidates. val
-    # holds no NaN (a NaN sample is −inf), so x ≥ y is not (y > x) and x = y is y = x: two comparisons
-    # of neighbours serve both sides
     with np.errstate(invalid="ignore"):
         ge_prev, eq_prev = np.empty(val.shape, bool), np.empty(val.shape, bool)
         ge_next, eq_next = np.empty(val.shape, bool), np.empty(val.shape, bool)
@@ -273,7 +260,68 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
         np.logical_and(ge_prev, np.isfinite(val), out=ge_prev)  # a peak
         np.logical_and(eq_prev, eq_next, out=eq_prev)  # flat on both sides
         np.logical_and(ge_prev, ~eq_prev, out=ge_prev)
-        rows, idx = np.nonzero(ge_prev)
+    return ge_prev
+
+
+def _neighbours(seq: _Sequence) -> tuple[np.ndarray, np.ndarray]:
+    """Whether each sample's previous and next one lie in its piece."""
+    m = seq.phi.size
+    same_prev = np.zeros(m, bool)
+    same_prev[1:] = seq.piece[1:] == seq.piece[:-1]
+    same_next = np.zeros(m, bool)
+    same_next[:-1] = seq.piece[:-1] == seq.piece[1:]
+    return same_prev, same_next
+
+
+def _outside_rests(seq: _Sequence, rests: Sequence[tuple[float, float]]) -> list[tuple[int, int]]:
+    """The runs [a, b) of samples whose bracket may reach out of every rest (:func:`_without_rests`).
+
+    A peak's bracket lies within its neighbours in its piece; where those lie
+    within one rest, so does any bracket of it, which :func:`_without_rests`
+    drops: such samples need not be looked at.
+    """
+    m = seq.phi.size
+    if not len(rests) or m == 0:
+        return [(0, m)]
+    same_prev, same_next = _neighbours(seq)
+    lo = np.where(same_prev, np.roll(seq.phi, 1), seq.phi)
+    hi = np.where(same_next, np.roll(seq.phi, -1), seq.phi)
+    span = np.asarray(rests, dtype=float).reshape(-1, 2)
+    inside = np.any((lo[:, None] >= span[:, 0]) & (hi[:, None] <= span[:, 1]), axis=1)
+    edges = np.flatnonzero(np.diff(np.r_[0, (~inside).astype(np.int8), 0]))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
+
+
+def _brackets(
+    seq: _Sequence, val: FloatArray, best: FloatArray, runs: Sequence[tuple[int, int]] | None = None
+) -> _Brackets:
+    """Every sampled local maximum of each row of ``val`` (signed: maxima sought) that could beat ``best``.
+
+    Interior peaks are bracketed by their two neighbours. A peak at a piece's
+    end (a one-sided limit larger than its neighbour) gets the bracket
+    [neighbour, end] too, since the function may rise above the limit just
+    inside the piece. A peak is kept where its value plus four times its drop
+    to the lower neighbour reaches the best sample: for a smooth peak the gain
+    of the true maximum over the sample is at most a quarter of that drop, so
+    this keeps a 16-fold margin. ``runs``: look at these runs [a, b) of
+    samples only (:func:`_outside_rests`); all by default.
+    """
+    m = val.shape[1]
+    same_prev, same_next = _neighbours(seq)
+    if runs is None or list(runs) == [(0, m)]:
+        rows, idx = np.nonzero(_peaks(val, same_prev, same_next))
+    else:  # each run with its neighbours, the peaks then in the whole array's order (row by row)
+        found_rows, found_idx = [np.empty(0, np.intp)], [np.empty(0, np.intp)]
+        for a, b in runs:
+            a0, b0 = max(a - 1, 0), min(b + 1, m)
+            peak = _peaks(val[:, a0:b0], same_prev[a0:b0], same_next[a0:b0])
+            r, i = np.nonzero(peak[:, a - a0 : b - a0])
+            found_rows.append(r)
+            found_idx.append(i + a)
+        rows, idx = np.concatenate(found_rows), np.concatenate(found_idx)
+        by_row = np.lexsort((idx, rows))
+        rows, idx = rows[by_row], idx[by_row]
+    with np.errstate(invalid="ignore"):
         here = val[rows, idx]
         prev_val = np.where(same_prev[idx], val[rows, idx - 1], -np.inf)
         next_val = np.where(same_next[idx], val[rows, (idx + 1) % m], -np.inf)
@@ -559,6 +607,7 @@ def _extremes(
     found: list[Extreme] = []
     twins: dict[int, int] = {}
     parts: list[_Brackets] = []
+    runs: list[tuple[int, int]] | None = None
     # the samples' extremes and the brackets, _ROW_BLOCK rows at a time (each row's alone: a block's
     # arrays stay in the processor's cache when a batch stacks the rows of many analyses)
     for lo in range(0, k, _ROW_BLOCK):
@@ -578,7 +627,9 @@ def _extremes(
                 strict=True,
             )
         ]
-        b = _brackets(seq, val, best[lo:hi])
+        if runs is None:  # the samples a bracket outside every rest may come from (the same for all rows)
+            runs = _outside_rests(seq, rests)
+        b = _brackets(seq, val, best[lo:hi], runs)
         parts.append(_Brackets(b.row + lo, b.x1, b.x2, b.x3, b.f1, b.f2, b.f3))
     br = (
         parts[0]

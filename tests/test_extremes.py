@@ -221,3 +221,30 @@ def test_layout_rows_is_the_sorted_columns(n, joints, k, lo_hi, seed) -> None:
     hi = min(max(lo + 1, lo_hi[1]), k)
     plain = np.take(np.concatenate((layout.right[lo:hi], layout.extra[lo:hi]), axis=1), layout.order, axis=1)
     assert np.array_equal(layout.rows(lo, hi).value, plain)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    data=st.lists(
+        st.lists(st.sampled_from([0.0, 1.0, 2.0, 2.0, 3.0, -math.inf, math.inf]), min_size=12, max_size=12),
+        min_size=1,
+        max_size=4,
+    ),
+    cuts=st.sets(st.integers(min_value=1, max_value=11), max_size=3),
+    rests=st.lists(st.tuples(st.integers(0, 11), st.integers(0, 11)).map(sorted).map(tuple), max_size=3),
+)
+def test_brackets_outside_rests_are_the_kept_ones(data, cuts, rests) -> None:
+    """Looking at the samples outside the rests only finds the brackets the rests rule keeps, in order."""
+    from camcad.extremes import _brackets, _fields, _outside_rests, _Sequence, _without_rests
+
+    val = np.array(data, dtype=float)
+    m = val.shape[1]
+    piece = np.searchsorted(sorted(cuts), np.arange(m), side="right")
+    phi = np.linspace(0.0, 5.5, m)
+    spans = [(float(phi[a]), float(phi[b])) for a, b in rests]
+    best = np.max(val, axis=1) - 1.0
+    seq = _Sequence(phi=phi, value=val, piece=piece, left=np.zeros(m, bool))
+    everything = _without_rests(_brackets(seq, val, best), spans)
+    looked = _without_rests(_brackets(seq, val, best, _outside_rests(seq, spans)), spans)
+    for a, b in zip(_fields(everything), _fields(looked), strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
