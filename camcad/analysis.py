@@ -7,14 +7,13 @@ sits below the report and the pipeline: both read it, neither is imported here.
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camcad._typing import FloatArray
+from camcad._typing import FloatArray, tree_copy
 from camcad._version import __version__
 from camcad.design import Design
 from camcad.design.paths import named_findings
@@ -194,7 +193,7 @@ class Analysis:
         out: dict[str, Any] = {
             "camcad_version": __version__,
             "design": {"name": self.design.cam.name, "source": self.design.source},
-            "motion": copy.deepcopy(self._memo["motion"]),
+            "motion": tree_copy(self._memo["motion"]),
             "geometry": self.geometry.summary(),
             "dynamics": self.dynamics.summary(),
             **self.family.summary(self.parts),  # a groove's flanks, a pair's second plate

@@ -170,9 +170,26 @@ class _Layout:
     extra: FloatArray
 
     def rows(self, lo: int, hi: int) -> _Sequence:
-        """The sequence of rows lo … hi − 1."""
-        value = np.take(np.concatenate((self.right[lo:hi], self.extra[lo:hi]), axis=1), self.order, axis=1)
+        """The sequence of rows lo … hi − 1.
+
+        Its columns are copied run by run (the grid's columns keep their
+        order, the extra ones fall in between): one pass over the values.
+        """
+        n = self.right.shape[1]
+        value = np.empty((hi - lo, self.order.size))
+        for a, b, src in self.runs():
+            if src < n:
+                value[:, a:b] = self.right[lo:hi, src : src + b - a]
+            else:
+                value[:, a:b] = self.extra[lo:hi, src - n : src - n + b - a]
         return _Sequence(phi=self.phi, value=value, piece=self.piece, left=self.left)
+
+    def runs(self) -> list[tuple[int, int, int]]:
+        """(a, b, src): columns a … b − 1 of the sequence are source columns src … of right, then extra."""
+        order, n = self.order, self.right.shape[1]
+        cut = np.flatnonzero((np.diff(order) != 1) | (order[1:] == n)) + 1
+        starts, ends = np.r_[0, cut].tolist(), np.r_[cut, order.size].tolist()
+        return [(a, b, int(order[a])) for a, b in zip(starts, ends, strict=True)]
 
 
 def _layout(
@@ -221,7 +238,63 @@ class _Brackets:
     f3: FloatArray
 
 
-def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
+def _peaks(val: FloatArray, same_prev: np.ndarray, same_next: np.ndarray) -> np.ndarray:
+    """(k, m) bool: a finite sample at least its neighbours in its piece, not flat on both sides.
+
+    Compared on the whole array (a neighbour outside the piece counts as
+    −inf). ``val`` holds no NaN (a NaN sample is −inf), so x ≥ y is not
+    (y > x) and x = y is y = x: two comparisons of neighbours serve both sides.
+    """
+    with np.errstate(invalid="ignore"):
+        ge_prev, eq_prev = np.empty(val.shape, bool), np.empty(val.shape, bool)
+        ge_next, eq_next = np.empty(val.shape, bool), np.empty(val.shape, bool)
+        np.greater(val[:, 1:], val[:, :-1], out=ge_prev[:, 1:])  # for now: greater than the previous
+        np.equal(val[:, 1:], val[:, :-1], out=eq_prev[:, 1:])
+        np.logical_not(ge_prev[:, 1:], out=ge_next[:, :-1])  # v[i] ≥ v[i + 1]: v[i + 1] not greater
+        eq_next[:, :-1] = eq_prev[:, 1:]
+        np.logical_or(ge_prev[:, 1:], eq_prev[:, 1:], out=ge_prev[:, 1:])
+        outside_prev, outside_next = np.flatnonzero(~same_prev), np.flatnonzero(~same_next)
+        ge_prev[:, outside_prev] = eq_prev[:, outside_prev] = True  # no neighbour before a piece's start
+        ge_next[:, outside_next] = eq_next[:, outside_next] = True  # nor after its end
+        np.logical_and(ge_prev, ge_next, out=ge_prev)
+        np.logical_and(ge_prev, np.isfinite(val), out=ge_prev)  # a peak
+        np.logical_and(eq_prev, eq_next, out=eq_prev)  # flat on both sides
+        np.logical_and(ge_prev, ~eq_prev, out=ge_prev)
+    return ge_prev
+
+
+def _neighbours(seq: _Sequence) -> tuple[np.ndarray, np.ndarray]:
+    """Whether each sample's previous and next one lie in its piece."""
+    m = seq.phi.size
+    same_prev = np.zeros(m, bool)
+    same_prev[1:] = seq.piece[1:] == seq.piece[:-1]
+    same_next = np.zeros(m, bool)
+    same_next[:-1] = seq.piece[:-1] == seq.piece[1:]
+    return same_prev, same_next
+
+
+def _outside_rests(seq: _Sequence, rests: Sequence[tuple[float, float]]) -> list[tuple[int, int]]:
+    """The runs [a, b) of samples whose bracket may reach out of every rest (:func:`_without_rests`).
+
+    A peak's bracket lies within its neighbours in its piece; where those lie
+    within one rest, so does any bracket of it, which :func:`_without_rests`
+    drops: such samples need not be looked at.
+    """
+    m = seq.phi.size
+    if not len(rests) or m == 0:
+        return [(0, m)]
+    same_prev, same_next = _neighbours(seq)
+    lo = np.where(same_prev, np.roll(seq.phi, 1), seq.phi)
+    hi = np.where(same_next, np.roll(seq.phi, -1), seq.phi)
+    span = np.asarray(rests, dtype=float).reshape(-1, 2)
+    inside = np.any((lo[:, None] >= span[:, 0]) & (hi[:, None] <= span[:, 1]), axis=1)
+    edges = np.flatnonzero(np.diff(np.r_[0, (~inside).astype(np.int8), 0]))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
+
+
+def _brackets(
+    seq: _Sequence, val: FloatArray, best: FloatArray, runs: Sequence[tuple[int, int]] | None = None
+) -> _Brackets:
     """Every sampled local maximum of each row of ``val`` (signed: maxima sought) that could beat ``best``.
 
     Interior peaks are bracketed by their two neighbours. A peak at a piece's
@@ -230,30 +303,25 @@ def _brackets(seq: _Sequence, val: FloatArray, best: FloatArray) -> _Brackets:
     inside the piece. A peak is kept where its value plus four times its drop
     to the lower neighbour reaches the best sample: for a smooth peak the gain
     of the true maximum over the sample is at most a quarter of that drop, so
-    this keeps a 16-fold margin.
+    this keeps a 16-fold margin. ``runs``: look at these runs [a, b) of
+    samples only (:func:`_outside_rests`); all by default.
     """
     m = val.shape[1]
-    same_prev = np.zeros(m, bool)
-    same_prev[1:] = seq.piece[1:] == seq.piece[:-1]
-    same_next = np.zeros(m, bool)
-    same_next[:-1] = seq.piece[:-1] == seq.piece[1:]
-    # a finite sample at least its neighbours in its piece, not flat on both sides: compared on the whole
-    # array (a neighbour outside the piece counts as −inf), the rest only at these few candidates
+    same_prev, same_next = _neighbours(seq)
+    if runs is None or list(runs) == [(0, m)]:
+        rows, idx = np.nonzero(_peaks(val, same_prev, same_next))
+    else:  # each run with its neighbours, the peaks then in the whole array's order (row by row)
+        found_rows, found_idx = [np.empty(0, np.intp)], [np.empty(0, np.intp)]
+        for a, b in runs:
+            a0, b0 = max(a - 1, 0), min(b + 1, m)
+            peak = _peaks(val[:, a0:b0], same_prev[a0:b0], same_next[a0:b0])
+            r, i = np.nonzero(peak[:, a - a0 : b - a0])
+            found_rows.append(r)
+            found_idx.append(i + a)
+        rows, idx = np.concatenate(found_rows), np.concatenate(found_idx)
+        by_row = np.lexsort((idx, rows))
+        rows, idx = rows[by_row], idx[by_row]
     with np.errstate(invalid="ignore"):
-        ge_prev, eq_prev = np.empty(val.shape, bool), np.empty(val.shape, bool)
-        ge_next, eq_next = np.empty(val.shape, bool), np.empty(val.shape, bool)
-        np.greater_equal(val[:, 1:], val[:, :-1], out=ge_prev[:, 1:])
-        np.equal(val[:, 1:], val[:, :-1], out=eq_prev[:, 1:])
-        np.greater_equal(val[:, :-1], val[:, 1:], out=ge_next[:, :-1])
-        np.equal(val[:, :-1], val[:, 1:], out=eq_next[:, :-1])
-        outside_prev, outside_next = np.flatnonzero(~same_prev), np.flatnonzero(~same_next)
-        ge_prev[:, outside_prev] = eq_prev[:, outside_prev] = True  # no neighbour before a piece's start
-        ge_next[:, outside_next] = eq_next[:, outside_next] = True  # nor after its end
-        np.logical_and(ge_prev, ge_next, out=ge_prev)
-        np.logical_and(ge_prev, np.isfinite(val), out=ge_prev)  # a peak
-        np.logical_and(eq_prev, eq_next, out=eq_prev)  # flat on both sides
-        np.logical_and(ge_prev, ~eq_prev, out=ge_prev)
-        rows, idx = np.nonzero(ge_prev)
         here = val[rows, idx]
         prev_val = np.where(same_prev[idx], val[rows, idx - 1], -np.inf)
         next_val = np.where(same_next[idx], val[rows, (idx + 1) % m], -np.inf)
@@ -539,13 +607,15 @@ def _extremes(
     found: list[Extreme] = []
     twins: dict[int, int] = {}
     parts: list[_Brackets] = []
+    runs: list[tuple[int, int]] | None = None
     # the samples' extremes and the brackets, _ROW_BLOCK rows at a time (each row's alone: a block's
     # arrays stay in the processor's cache when a batch stacks the rows of many analyses)
     for lo in range(0, k, _ROW_BLOCK):
         hi = min(k, lo + _ROW_BLOCK)
         seq = layout.rows(lo, hi)
         sg = sign[lo:hi]
-        val = sg * np.where(np.isnan(seq.value), -sg * np.inf, seq.value)
+        val = sg * seq.value  # signed (exact: ±1), a NaN sample then −inf
+        np.copyto(val, -np.inf, where=np.isnan(val))
         top = np.argmax(val, axis=1)
         best[lo:hi] = val[np.arange(hi - lo), top]
         found += [
@@ -557,7 +627,9 @@ def _extremes(
                 strict=True,
             )
         ]
-        b = _brackets(seq, val, best[lo:hi])
+        if runs is None:  # the samples a bracket outside every rest may come from (the same for all rows)
+            runs = _outside_rests(seq, rests)
+        b = _brackets(seq, val, best[lo:hi], runs)
         parts.append(_Brackets(b.row + lo, b.x1, b.x2, b.x3, b.f1, b.f2, b.f3))
     br = (
         parts[0]

@@ -195,3 +195,56 @@ def test_every_rows_sample_side_at_once_is_each_rows_alone(seed, k):
     at_joints = np.flatnonzero(np.isin(np.mod(seq.phi, 2 * math.pi), joints) | (seq.phi == 0.0))
     top = rng.choice(np.concatenate((at_joints, rng.integers(0, seq.phi.size, 4))), k)
     assert ex._sample_sides(seq, top, {}) == [ex._sample_side(seq, r, int(top[r])) for r in range(k)]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(min_value=2, max_value=40),
+    joints=st.lists(st.floats(min_value=0.0, max_value=6.28), max_size=5),
+    k=st.integers(min_value=1, max_value=5),
+    lo_hi=st.tuples(st.integers(0, 4), st.integers(1, 5)),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_layout_rows_is_the_sorted_columns(n, joints, k, lo_hi, seed) -> None:
+    """A search's sequence of rows: the grid's and the extra columns taken in ``order`` (the plain gather)."""
+    from camcad.extremes import _layout
+
+    grid = np.sort(np.random.default_rng(seed).uniform(0.0, 2 * math.pi, n))
+    grid = np.unique(np.concatenate((grid, [0.0])))
+    rng = np.random.default_rng(seed + 1)
+
+    def quantity(p, side):
+        return rng.normal(size=(k, p.size))
+
+    layout = _layout(quantity, grid, np.asarray(joints, dtype=float), None, k)
+    lo = min(lo_hi[0], k - 1)
+    hi = min(max(lo + 1, lo_hi[1]), k)
+    plain = np.take(np.concatenate((layout.right[lo:hi], layout.extra[lo:hi]), axis=1), layout.order, axis=1)
+    assert np.array_equal(layout.rows(lo, hi).value, plain)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    data=st.lists(
+        st.lists(st.sampled_from([0.0, 1.0, 2.0, 2.0, 3.0, -math.inf, math.inf]), min_size=12, max_size=12),
+        min_size=1,
+        max_size=4,
+    ),
+    cuts=st.sets(st.integers(min_value=1, max_value=11), max_size=3),
+    rests=st.lists(st.tuples(st.integers(0, 11), st.integers(0, 11)).map(sorted).map(tuple), max_size=3),
+)
+def test_brackets_outside_rests_are_the_kept_ones(data, cuts, rests) -> None:
+    """Looking at the samples outside the rests only finds the brackets the rests rule keeps, in order."""
+    from camcad.extremes import _brackets, _fields, _outside_rests, _Sequence, _without_rests
+
+    val = np.array(data, dtype=float)
+    m = val.shape[1]
+    piece = np.searchsorted(sorted(cuts), np.arange(m), side="right")
+    phi = np.linspace(0.0, 5.5, m)
+    spans = [(float(phi[a]), float(phi[b])) for a, b in rests]
+    best = np.max(val, axis=1) - 1.0
+    seq = _Sequence(phi=phi, value=val, piece=piece, left=np.zeros(m, bool))
+    everything = _without_rests(_brackets(seq, val, best), spans)
+    looked = _without_rests(_brackets(seq, val, best, _outside_rests(seq, spans)), spans)
+    for a, b in zip(_fields(everything), _fields(looked), strict=True):
+        assert np.array_equal(a, b, equal_nan=True)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import difflib
 import enum
+import functools
 import math
 import numbers
 import re
@@ -223,9 +224,15 @@ def _to_floatlist(path: str, rule: _Rule, value: Any) -> tuple[float, ...]:
     return tuple(_to_float(f"{path}[{i}]", rule, v) for i, v in enumerate(value))
 
 
+@functools.cache
+def _enum_values(kind: type[enum.Enum]) -> tuple[Any, ...]:
+    """The values of an enum's members, in order (listed once per enum: a sweep parses many designs)."""
+    return tuple(m.value for m in kind)
+
+
 def _to_enum(path: str, rule: _Rule, value: Any) -> enum.Enum:
     assert rule.enum is not None
-    allowed = [m.value for m in rule.enum]
+    allowed = _enum_values(rule.enum)
     if not isinstance(value, str) or value not in allowed:
         word = value[:100] if isinstance(value, str) else ""
         close = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6)

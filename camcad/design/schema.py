@@ -248,7 +248,7 @@ def parse_tolerance(table: Any, design: Design) -> ToleranceSpec:
     DesignError
         Naming the key (``tolerance.form_pm``), the value and what is allowed.
     """
-    from camcad.geometry.sensitivity import applicable, mount_of  # only a study needs these (SciPy)
+    from camcad.geometry.sensitivity import applicable_to  # only a study needs these (SciPy)
     from camcad.inspect.spec import Evaluation, StudyMethod, ToleranceSpec
     from camcad.inspect.tolerance import Distribution, Method, Tolerance
 
@@ -259,7 +259,7 @@ def parse_tolerance(table: Any, design: Design) -> ToleranceSpec:
         kw["allocation"] = Method(kw["allocation"].value)
     if "evaluation" in kw:
         kw["evaluation"] = Evaluation(kw["evaluation"].value)
-    allowed = applicable(mount_of(Cam.from_design(design)))
+    allowed = applicable_to(Cam.from_design(design))
     tolerances: list[Tolerance] = []
     keys: list[str] = []
     for name, tol in _TOLERANCED.items():

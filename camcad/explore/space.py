@@ -22,7 +22,6 @@ continuous range: optimization, Latin-hypercube sampling) or
 
 from __future__ import annotations
 
-import copy
 import itertools
 import math
 import re
@@ -32,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from camcad._typing import tree_copy
 from camcad.design import Design, parse_design
 from camcad.errors import DesignError, UsageError
 from camcad.motion.laws import LAWS
@@ -302,7 +302,7 @@ def apply_values(
     Setting a law keeps the segment's parameters that the new law takes and
     drops the others (a VAP's ``b`` on a change to cycloidal).
     """
-    out: dict[str, Any] = copy.deepcopy(dict(data))
+    out: dict[str, Any] = tree_copy(dict(data))
     for variable, value in zip(variables, values, strict=True):
         for table, index, key in _targets(variable.path, out, "--vary", variable.name):
             if index is None:

@@ -63,6 +63,7 @@ __all__ = [
     "Sensitivity",
     "Tol",
     "applicable",
+    "applicable_to",
     "mount_of",
     "pressure_angle_identity",
     "sensitivities",
@@ -142,6 +143,21 @@ def applicable(mount: Mount) -> tuple[Tol, ...]:
         out.append(Tol.ARM_LENGTH if mount.has_circle else Tol.FACE_OFFSET)
     out.append(Tol.PHASE)
     return tuple(out)
+
+
+def applicable_to(cam: Cam) -> tuple[Tol, ...]:
+    """``applicable(mount_of(cam))``, a slide's read off its guide and roller (no motion evaluated).
+
+    A slide's mount has the guide's axis and the follower's roller radius,
+    all :func:`applicable` reads; an arm's (whose element decides whether it
+    has a circle) is found by :func:`mount_of`. Refuses what it refuses.
+    """
+    if cam.conjugate is not None:
+        return applicable(mount_of(cam))  # its refusal
+    kin = cam.follower
+    if kin.guide.axis is None:
+        return applicable(mount_of(cam))
+    return applicable(Mount(sigma=cam.sigma, roller_radius=kin.roller_radius, axis=kin.guide.axis))
 
 
 def mount_of(cam: Cam) -> Mount:

@@ -140,7 +140,7 @@ class MotionProgram:
     segments: tuple[SegmentSpec, ...]
     starts: tuple[float, ...]  # rad, start angle of each segment
     base_s: tuple[float, ...]  # mm, displacement at each segment's start
-    _memo: dict[str, Any] = field(  # the joints and the last sample grid, found once (see joints, sample_phi)
+    _memo: dict[str, Any] = field(  # the joints, breakpoints, the last sample grid: found once
         default_factory=dict, init=False, compare=False, hash=False, repr=False
     )
 
@@ -309,8 +309,13 @@ class MotionProgram:
 
     @property
     def breakpoints(self) -> tuple[Breakpoint, ...]:
-        """Every segment joint with its continuity order (the fit puts knots here)."""
-        return tuple(Breakpoint(phi=jt.phi, continuity=jt.continuity) for jt in self.joints())
+        """Every segment joint with its continuity order (the fit puts knots here); found once per program."""
+        if "breakpoints" not in self._memo:
+            self._memo["breakpoints"] = tuple(
+                Breakpoint(phi=jt.phi, continuity=jt.continuity) for jt in self.joints()
+            )
+        out: tuple[Breakpoint, ...] = self._memo["breakpoints"]
+        return out
 
     @property
     def blend_points(self) -> tuple[Breakpoint, ...]:

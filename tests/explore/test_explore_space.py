@@ -170,3 +170,36 @@ def test_toml_text_round_trips_any_table(tables, motion):
     if motion:
         data["motion"] = motion
     assert tomllib.loads(toml_text(data)) == data
+
+
+_TOML_LEAF = st.one_of(
+    st.none(), st.booleans(), st.integers(), st.floats(allow_nan=False), st.text(max_size=4)
+)
+_TOML_TREE = st.recursive(
+    _TOML_LEAF,
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=3), inner, max_size=3),
+    max_leaves=12,
+)
+
+
+def _containers(value: object) -> list[object]:
+    if isinstance(value, dict):
+        return [value, *(c for v in value.values() for c in _containers(v))]
+    if isinstance(value, list):
+        return [value, *(c for v in value for c in _containers(v))]
+    return []
+
+
+@settings(max_examples=80, deadline=None)
+@given(tree=_TOML_TREE)
+def test_tree_copy_is_deepcopy(tree) -> None:
+    """tree_copy (a sweep's per-variant copy) is copy.deepcopy and shares no dict or list with its input."""
+    import copy
+
+    from camcad._typing import tree_copy
+
+    got = tree_copy(tree)
+    assert got == copy.deepcopy(tree)
+    assert repr(got) == repr(tree)  # the same types, in the same order
+    mine = {id(c) for c in _containers(tree)}
+    assert not mine & {id(c) for c in _containers(got)}

@@ -14,7 +14,8 @@ from numpy.testing import assert_allclose
 
 from camcad.geometry.made import made_motion
 from camcad.geometry.sensitivity import Tol, mount_of, pressure_angle_identity, sensitivities
-from tests.inspect.conftest import CAMS
+from tests.conftest import SAMPLES
+from tests.inspect.conftest import CAMS, sample_cam
 from tests.named import raises_named
 
 PHI = np.linspace(0.0, 2.0 * np.pi, 361, endpoint=False) + 1e-3
@@ -121,3 +122,23 @@ def test_phase_is_exactly_a_late_motion(any_cam):
     assert_allclose(made.velocity, late.v, atol=1e-10 * scale)
     finite = np.isfinite(made.acceleration)
     assert_allclose(made.acceleration[finite], late.a[finite], atol=1e-9 * scale)
+
+
+def _applicable_or_error(read, cam):
+    from camcad.errors import CamcadError
+
+    try:
+        return read(cam)
+    except CamcadError as err:
+        return (type(err), str(err))
+
+
+@pytest.mark.parametrize("name", [*sorted(CAMS), *(f"sample:{p.stem}" for p in SAMPLES)])
+def test_applicable_to_is_applicable_of_the_mount(name):
+    """applicable_to (what [tolerance] checks its keys against) = applicable(mount_of(cam)), refusals too."""
+    from camcad.geometry.sensitivity import applicable, applicable_to
+
+    cam = sample_cam(name.removeprefix("sample:")) if name.startswith("sample:") else CAMS[name]()
+    assert _applicable_or_error(applicable_to, cam) == _applicable_or_error(
+        lambda c: applicable(mount_of(c)), cam
+    )
