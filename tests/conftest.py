@@ -108,6 +108,40 @@ def serving(folder: Path, **options: Any) -> Iterator[tuple[Any, str, Path]]:
         srv.server_close()
 
 
+# Files run on one pytest-xdist worker together (``--dist loadgroup``, pyproject.toml); every other
+# file is a group of its own, so its module-scoped builds run once. Runs of LinuxCNC's rs274 at once
+# clash (its tool table is shared through /tmp); two Chromiums at once would crowd the two cores.
+_SERIAL_GROUPS = {
+    "rs274": (
+        "tests/readers/test_rs274.py",
+        "tests/readers/test_rs274_conjugate.py",
+        "tests/readers/test_rs274_groove.py",
+        "tests/readers/test_rs274_linear.py",
+        "tests/readers/test_rs274_rotary.py",
+        "tests/readers/test_barrel_readers.py",
+        "tests/test_barrel_family.py",
+        "tests/cli/test_inspect_cli.py",
+    ),
+    "chromium": (
+        "tests/readers/test_chromium_report.py",
+        "tests/readers/test_chromium_serve.py",
+        "tests/readers/test_chromium_sweep.py",
+    ),
+}
+_GROUP_OF = {path: group for group, paths in _SERIAL_GROUPS.items() for path in paths}
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the marks
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Give each test one ``xdist_group``: its file's, or the shared group of its file."""
+    for item in items:
+        try:
+            name = item.path.resolve().relative_to(ROOT).as_posix()
+        except ValueError:
+            name = str(item.path)
+        item.add_marker(pytest.mark.xdist_group(_GROUP_OF.get(name, name)))
+
+
 @pytest.fixture(autouse=True)
 def _sigpipe_ignored() -> Iterator[None]:
     """Python's own SIGPIPE setting (ignored) around every test.

@@ -68,7 +68,9 @@ CASES = [
 
 
 @pytest.mark.parametrize(
-    ("where", "value", "path", "words"), CASES, ids=[c[0] + "=" + repr(c[1]) for c in CASES]
+    ("where", "value", "path", "words"),
+    CASES,
+    ids=[c[0] + ("-deleted" if c[1] is DELETE else "=" + repr(c[1])) for c in CASES],
 )
 def test_bad_designs_name_the_field_and_what_is_allowed(where, value, path, words):
     with pytest.raises(DesignError) as info:
