@@ -100,7 +100,7 @@ def speed_bounds(
     """
     a = np.asarray(inertia, dtype=float)
     need = margin * np.asarray(ratio, dtype=float) - np.asarray(static, dtype=float)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # A tiny: the bound ±inf, as A → 0
         bound = need / a
     flat: FloatArray = np.where(a == 0.0, need, -np.inf)
     upper: FloatArray = np.where(a < 0.0, bound, np.inf)
