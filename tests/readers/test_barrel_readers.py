@@ -18,6 +18,7 @@ import math
 import re
 from functools import cache
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -62,6 +63,26 @@ def canon_passes(canon: str) -> list[dict]:
     return passes
 
 
+def rs274_passes(folder: Path, tp: Any, *, name: str, rough_diameter: float) -> tuple[list[dict], str]:
+    """Write ``tp``'s program and a tool table (T1 the rougher, T2 the 16 mm finisher) into ``folder``,
+    run rs274 on them (no message but "executing", to PROGRAM_END) and return its canonical passes,
+    one per planned pass and of its kind, and the program's text."""
+    rs274 = require("rs274")
+    text = render_barrel_program(tp, name=name)
+    (folder / "cam.ngc").write_text(text, encoding="ascii")
+    table = f"T1 P1 Z0 D{rough_diameter:g} ;rough\nT2 P2 Z0 D16 ;finish\n"
+    (folder / "tools.tbl").write_text(table, encoding="ascii")
+    proc = run([rs274, "-t", "tools.tbl", "-g", "cam.ngc", "canon.txt"], cwd=folder)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    lines = [s for s in (proc.stdout + proc.stderr).splitlines() if s.strip() and s.strip() != "executing"]
+    assert not lines
+    canon = (folder / "canon.txt").read_text(encoding="ascii")
+    assert "PROGRAM_END" in canon
+    passes = canon_passes(canon)
+    assert [p["kind"] for p in passes] == [p.kind for p in tp.passes]
+    return passes, text
+
+
 def centres(moves, station: float, spacing: float = 0.02) -> tuple[np.ndarray, float]:
     """The tool axis at ``station`` in the developed plane, dense along each block; and the tip Z."""
     out, tips = [], set()
@@ -80,19 +101,8 @@ def centres(moves, station: float, spacing: float = 0.02) -> tuple[np.ndarray, f
 
 @pytest.mark.parametrize("name", NAMES)
 def test_rs274_runs_the_program_and_the_finish_cuts_the_exact_walls(name, tmp_path):
-    rs274 = require("rs274")
     c, tp = CASES[name], planned(name)
-    text = render_barrel_program(tp, name=name)
-    (tmp_path / "cam.ngc").write_text(text, encoding="ascii")
-    (tmp_path / "tools.tbl").write_text("T1 P1 Z0 D10 ;rough\nT2 P2 Z0 D16 ;finish\n", encoding="ascii")
-    proc = run([rs274, "-t", "tools.tbl", "-g", "cam.ngc", "canon.txt"], cwd=tmp_path)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    lines = [s for s in (proc.stdout + proc.stderr).splitlines() if s.strip() and s.strip() != "executing"]
-    assert not lines
-    canon = (tmp_path / "canon.txt").read_text(encoding="ascii")
-    assert "PROGRAM_END" in canon
-    passes = canon_passes(canon)
-    assert [p["kind"] for p in passes] == [p.kind for p in tp.passes]
+    passes, _ = rs274_passes(tmp_path, tp, name=name, rough_diameter=10.0)
     o, spec = c.options, tp.options
     r_w = o.roller_radius + 0.5 * o.clearance
     phi = np.linspace(0.0, 2.0 * math.pi, 100_001)

@@ -25,12 +25,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from camcad.export.gcode.barrel import render_barrel_program
 from camcad.geometry.barrel import WallSide, faces_at_radius
 from camcad.toolpath.barrel import BarrelToolpathOptions, plan_barrel
 from tests.barrel_cases import RIB
-from tests.readers.conftest import require, run
-from tests.readers.test_barrel_readers import _positions, _swept_distance, canon_passes
+from tests.readers.test_barrel_readers import _positions, _swept_distance, rs274_passes
 
 pytestmark = pytest.mark.slow
 SPEC = BarrelToolpathOptions(rough_diameter=9.5, tolerance=0.005)
@@ -40,19 +38,8 @@ SPEC = BarrelToolpathOptions(rough_diameter=9.5, tolerance=0.005)
 def rib_passes(folder: Path) -> tuple[list[dict], str]:
     """rs274's canonical moves of the rib's program: the deepest roughing level's and the finishing
     passes (the others shown to lie inside them); and the program's text."""
-    rs274 = require("rs274")
     tp = plan_barrel(RIB.program, RIB.follower, RIB.options, SPEC)
-    text = render_barrel_program(tp, name="rib")
-    (folder / "cam.ngc").write_text(text, encoding="ascii")
-    (folder / "tools.tbl").write_text("T1 P1 Z0 D9.5 ;rough\nT2 P2 Z0 D16 ;finish\n", encoding="ascii")
-    proc = run([rs274, "-t", "tools.tbl", "-g", "cam.ngc", "canon.txt"], cwd=folder)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    lines = [s for s in (proc.stdout + proc.stderr).splitlines() if s.strip() and s.strip() != "executing"]
-    assert not lines
-    canon = (folder / "canon.txt").read_text(encoding="ascii")
-    assert "PROGRAM_END" in canon
-    passes = canon_passes(canon)
-    assert [p["kind"] for p in passes] == [p.kind for p in tp.passes]
+    passes, text = rs274_passes(folder, tp, name="rib", rough_diameter=9.5)
     # every roughing level repeats the deepest one's X, Y, A: a body reaching lower holds the higher
     # one's, so the deepest level and the finishing passes are the whole cut
     levels: dict[float, list[np.ndarray]] = {}
