@@ -148,3 +148,28 @@ def assert_same_outputs(first: Path, again: Path) -> None:
             assert a == b
             continue
         assert (first / n).read_bytes() == (again / n).read_bytes(), n
+
+
+def step_solid_volume(path: Path) -> float:
+    """OpenCASCADE reads the STEP file: one solid, valid for ``BRepCheck_Analyzer``; its volume [mm³]."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == IFSelect_RetDone
+    reader.TransferRoots()
+    shape = reader.OneShape()
+    solids, explorer = 0, TopExp_Explorer(shape, TopAbs_SOLID)
+    while explorer.More():
+        solids += 1
+        explorer.Next()
+    assert solids == 1
+    assert BRepCheck_Analyzer(shape).IsValid()
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props, 1e-7)
+    return float(props.Mass())
