@@ -351,18 +351,13 @@ def plan_barrel(
         else (options.roller_radius + 0.5 * options.clearance)
     )
     r_c = 0.5 * spec.rough_diameter
-    reach = r_w - r_c - spec.stock
-    if reach < 0.0:
-        raise DesignError(
-            Knob.ROUGH_DIAMETER,
-            f"{spec.rough_diameter:g} mm does not fit the groove {2 * r_w:g} mm wide with {spec.stock:g} mm "
-            f"stock on each wall; give rough_diameter ≤ {2 * (r_w - spec.stock):g} mm",
-        )
+    reach = _rough_reach(
+        r_w, spec, f"the groove {2 * r_w:g} mm wide with {spec.stock:g} mm stock on each wall"
+    )
     count = max(1, math.ceil(2.0 * reach / (spec.stepover * spec.rough_diameter)) + 1) if reach > 0 else 1
     shifts = np.linspace(-reach, reach, count) if count > 1 else np.zeros(1)
     bottom = options.bottom_radius + spec.stock
-    levels = np.arange(options.barrel_radius - spec.step_down, bottom, -spec.step_down)
-    levels = np.r_[levels[levels > bottom], bottom]
+    levels = _levels(options.barrel_radius, bottom, spec.step_down)
     passes = [
         _pass(
             program,
@@ -417,6 +412,28 @@ def plan_barrel(
     return BarrelToolpath(passes=tuple(passes), options=spec, barrel=options, small_cutter=small)
 
 
+def _rough_reach(r_w: float, spec: BarrelToolpathOptions, room: str) -> float:
+    """How far [mm] the rougher's axis may shift either way of the roller's path: r_w − r_c − stock ≥ 0.
+
+    ``room`` names the space it must fit in, for the error.
+    """
+    reach = r_w - 0.5 * spec.rough_diameter - spec.stock
+    if reach < 0.0:
+        raise DesignError(
+            Knob.ROUGH_DIAMETER,
+            f"{spec.rough_diameter:g} mm does not fit {room}; "
+            f"give rough_diameter ≤ {2 * (r_w - spec.stock):g} mm",
+        )
+    return reach
+
+
+def _levels(top: float, bottom: float, step_down: float) -> FloatArray:
+    """The roughing levels [mm from the axis]: from step_down below ``top`` down to ``bottom``, the last."""
+    levels = np.arange(top - step_down, bottom, -step_down)
+    out: FloatArray = np.r_[levels[levels > bottom], bottom]
+    return out
+
+
 def _plan_rib(
     program: MotionProgram,
     follower: TranslatingBarrelRoller | OscillatingBarrelRoller,
@@ -426,18 +443,15 @@ def _plan_rib(
     """The barrel round a rib: each side roughed from its roller's path outwards, each face finished."""
     r_w = options.roller_radius + 0.5 * options.clearance
     r_c = 0.5 * spec.rough_diameter
-    reach = r_w - r_c - spec.stock
-    if reach < 0.0:
-        raise DesignError(
-            Knob.ROUGH_DIAMETER,
-            f"{spec.rough_diameter:g} mm does not fit the gap {2 * r_w:g} mm wide each roller runs in "
-            f"beside the rib with {spec.stock:g} mm stock on its face; "
-            f"give rough_diameter ≤ {2 * (r_w - spec.stock):g} mm",
-        )
+    reach = _rough_reach(
+        r_w,
+        spec,
+        f"the gap {2 * r_w:g} mm wide each roller runs in beside the rib "
+        f"with {spec.stock:g} mm stock on its face",
+    )
     step = spec.stepover * spec.rough_diameter
     bottom = options.bottom_radius
-    levels = np.arange(options.barrel_radius - spec.step_down, bottom, -spec.step_down)
-    levels = np.r_[levels[levels > bottom], bottom]  # the floor round the rib: cut to the root
+    levels = _levels(options.barrel_radius, bottom, spec.step_down)  # the floor round the rib: to the root
     up, low = rib_rollers(follower, options)
     near = np.linspace(0.0, reach, max(1, math.ceil(reach / step) + 1)) if reach > 0.0 else np.zeros(1)
     sides: list[list[BarrelPass]] = []
